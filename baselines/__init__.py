@@ -1,0 +1,1 @@
+"""Scripted visual-homing controllers (filled in by the evaluation-harness issue)."""

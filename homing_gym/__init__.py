@@ -1,0 +1,33 @@
+"""homing-gym: Gymnasium environments for visual homing with a panoramic-camera robot.
+
+>>> import gymnasium as gym, homing_gym
+>>> gym.register_envs(homing_gym)
+>>> env = gym.make("homing_gym/LocalHoming-v0")
+"""
+
+from __future__ import annotations
+
+import gymnasium as gym
+
+__version__ = "0.1.0"
+
+#: Registered env ids, with their entry points and step limits.
+_ENVS = {
+    "homing_gym/LocalHoming-v0": ("homing_gym.envs:LocalHomingEnv", 500),
+}
+ENV_IDS: tuple[str, ...] = tuple(_ENVS)
+
+
+def register_envs() -> None:
+    """Register every env id with Gymnasium; calling it again changes nothing."""
+    for env_id, (entry_point, steps) in _ENVS.items():
+        if env_id not in gym.registry:
+            gym.register(id=env_id, entry_point=entry_point, max_episode_steps=steps)
+
+
+register_envs()
+
+from homing_gym.env import HomingEnv  # noqa: E402
+from homing_gym.envs import LocalHomingEnv  # noqa: E402
+
+__all__ = ["ENV_IDS", "HomingEnv", "LocalHomingEnv", "register_envs", "__version__"]

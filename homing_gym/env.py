@@ -1,0 +1,260 @@
+"""The env core: simulator + robot + panoramic camera + a task, behind the Gymnasium API.
+
+:class:`HomingEnv` knows nothing about any particular task or scene: the scene comes from
+the scene registry (:mod:`homing_gym.scenes`), the episode logic from a
+:class:`~homing_gym.tasks.Task`, the observation keys from :data:`OBSERVATION_KEYS` and
+the task's own keys. Registered envs (``homing_gym/LocalHoming-v0``, ...) are thin
+subclasses in :mod:`homing_gym.envs` that choose the task and carry the env card.
+"""
+
+from __future__ import annotations
+
+import math
+import pkgutil
+import warnings
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+import pybullet as p
+from gymnasium import spaces
+
+from homing_gym.geometry import to_frame
+from homing_gym.panorama import CameraConfig, PanoramaCamera
+from homing_gym.robot import RobotConfig, WheelOdometry
+from homing_gym.scenes import scene_factory
+from homing_gym.scenes.base import Scene
+from homing_gym.simulator import Simulator
+from homing_gym.tasks.base import Episode, Task
+from homing_gym.topdown import compose_frame, draw_topdown
+
+ACTION_TYPES = ("continuous", "discrete")
+#: Discrete actions: index -> (forward, yaw) in normalised units.
+DISCRETE_ACTIONS = {0: (1.0, 0.0), 1: (0.0, 1.0), 2: (0.0, -1.0), 3: (0.0, 0.0)}
+DISCRETE_NAMES = ("forward", "turn_left", "turn_right", "stop")
+#: Observation keys the env core provides (tasks may add more).
+OBSERVATION_KEYS = ("panorama", "goal", "omni", "goal_omni", "signature", "goal_signature",
+                    "odometry")
+
+
+class HomingEnv(gym.Env):
+    """A differential-drive robot with a panoramic camera in a PyBullet scene.
+
+    See :class:`homing_gym.envs.LocalHomingEnv` for the full description of spaces and
+    arguments; ``task`` is a :class:`~homing_gym.tasks.Task` instance.
+    """
+
+    metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 10}
+
+    def __init__(self, task: Task, scene: str | Scene = "arena", *,
+                 render_mode: str | None = None,
+                 obs_keys: tuple[str, ...] | list[str] = ("panorama", "goal"),
+                 panorama_shape: tuple[int, int] = CameraConfig.panorama_shape,
+                 vfov_deg: float = math.degrees(CameraConfig.vfov),
+                 n_views: int = CameraConfig.n_views, renderer: str = CameraConfig.renderer,
+                 omni_size: int = CameraConfig.omni_size,
+                 action_type: str = "continuous", control_period: float = 0.1,
+                 physics_substeps: int = 24, max_speed: float = RobotConfig.max_speed,
+                 max_yaw_rate: float = RobotConfig.max_yaw_rate, stop_threshold: float = 0.05,
+                 odometry_noise: float = 0.02):
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"unknown render_mode {render_mode!r}; allowed: "
+                             f"{self.metadata['render_modes']} or None")
+        if action_type not in ACTION_TYPES:
+            raise ValueError(f"unknown action_type {action_type!r}; allowed: {ACTION_TYPES}")
+        if not (isinstance(physics_substeps, (int, np.integer)) and physics_substeps >= 1):
+            raise ValueError(f"physics_substeps must be an integer >= 1, got {physics_substeps!r}")
+        if not (math.isfinite(control_period) and control_period > 0):
+            raise ValueError(f"control_period must be positive seconds, got {control_period!r}")
+        for name, value in (("max_speed", max_speed), ("max_yaw_rate", max_yaw_rate)):
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"{name} must be a positive number, got {value!r}")
+        if not (0 <= stop_threshold < 1):
+            raise ValueError(f"stop_threshold must be in [0, 1), got {stop_threshold!r}")
+        task_keys = task.extra_spaces()
+        allowed = OBSERVATION_KEYS + tuple(task_keys)
+        unknown = [k for k in obs_keys if k not in allowed]
+        if unknown or len(obs_keys) == 0 or len(set(obs_keys)) != len(obs_keys):
+            raise ValueError(f"bad obs_keys {tuple(obs_keys)!r}: give distinct keys from {allowed}")
+
+        self.render_mode = render_mode
+        self.task = task
+        self.obs_keys = tuple(obs_keys)
+        self.action_type = action_type
+        self.control_period = float(control_period)
+        self.physics_substeps = int(physics_substeps)
+        self.stop_threshold = float(stop_threshold)
+        self.robot_config = RobotConfig(max_speed=float(max_speed),
+                                        max_yaw_rate=float(max_yaw_rate))
+        self.camera = PanoramaCamera(
+            CameraConfig(panorama_shape=tuple(panorama_shape), vfov=math.radians(vfov_deg),
+                         n_views=n_views, omni_size=omni_size, renderer=renderer),
+            camera_height=self.robot_config.camera_height)
+        self.odometry = WheelOdometry(self.robot_config, odometry_noise)
+        self._scene_factory = scene_factory(scene)
+        self.scene = self._scene_factory.build(np.random.default_rng(0))
+        self.sim = Simulator(self.scene, gui=render_mode == "human",
+                             time_step=self.control_period / self.physics_substeps,
+                             robot_config=self.robot_config)
+        self._renderer = self._renderer_id(renderer)
+
+        H, W = self.camera.config.panorama_shape
+        S = self.camera.config.omni_size
+        image = spaces.Box(0, 255, (H, W, 3), np.uint8)
+        ring = spaces.Box(0, 255, (S, S, 3), np.uint8)
+        signature = spaces.Box(0.0, 1.0, (W,), np.float32)
+        core = {"panorama": image, "goal": image, "omni": ring, "goal_omni": ring,
+                "signature": signature, "goal_signature": signature,
+                "odometry": spaces.Box(-np.inf, np.inf, (3,), np.float32)}
+        core.update(task_keys)
+        self.observation_space = spaces.Dict({k: core[k] for k in self.obs_keys})
+        if action_type == "discrete":
+            self.action_space = spaces.Discrete(len(DISCRETE_ACTIONS))
+        else:
+            self.action_space = spaces.Box(-1.0, 1.0, (2,), np.float32)
+
+        self.episode: Episode | None = None
+        self.pose = np.zeros(3)
+        self.trajectory: list[tuple[float, float]] = []
+        self.collisions = 0
+        self._panorama = np.zeros((H, W, 3), np.uint8)
+        self._goal_obs: dict[str, np.ndarray] = {}
+
+    # -- helpers --------------------------------------------------------------------------
+    def _renderer_id(self, renderer: str) -> int:
+        if renderer == "tiny":
+            return p.ER_TINY_RENDERER
+        egl = pkgutil.get_loader("eglRenderer")
+        plugin = -1
+        if egl is not None:
+            plugin = self.sim.client.loadPlugin(egl.get_filename(), "_eglRendererPlugin")
+        if plugin < 0:
+            warnings.warn("renderer='egl' requested but the EGL plugin could not be loaded; "
+                          "falling back to TinyRenderer", RuntimeWarning, stacklevel=3)
+            return p.ER_TINY_RENDERER
+        return p.ER_BULLET_HARDWARE_OPENGL
+
+    def render_panorama(self, pose) -> np.ndarray:
+        """Panorama (uint8 HWC) the robot's camera would see at ``pose`` in the current
+        world, rendered as is (the robot body stays where it is)."""
+        return self.camera.render(self.sim.client, pose, self._renderer)
+
+    @property
+    def distance_to_goal(self) -> float:
+        """Distance (metres) between the robot centre and the home position."""
+        return float(math.hypot(self.pose[0] - self.episode.home[0],
+                                self.pose[1] - self.episode.home[1]))
+
+    def _command(self, action) -> tuple[float, float, bool]:
+        """Validated action -> (forward, yaw) in normalised units and the stop flag."""
+        if self.action_type == "discrete":
+            if not (np.ndim(action) == 0 and float(action) == int(action)
+                    and int(action) in DISCRETE_ACTIONS):
+                raise ValueError(f"action {action!r} is not one of {list(DISCRETE_ACTIONS)} "
+                                 f"({', '.join(DISCRETE_NAMES)})")
+            v, w = DISCRETE_ACTIONS[int(action)]
+            return v, w, int(action) == 3
+        a = np.asarray(action, dtype=np.float64)
+        if a.shape != (2,):
+            raise ValueError(f"action {action!r} must have shape (2,) = (forward, yaw rate)")
+        if not np.all(np.isfinite(a)):
+            raise ValueError(f"action {action!r} contains NaN or infinity")
+        v, w = np.clip(a, -1.0, 1.0)
+        stop = abs(v) < self.stop_threshold and abs(w) < self.stop_threshold
+        return float(v), float(w), bool(stop)
+
+    def _observation(self) -> dict[str, np.ndarray]:
+        obs: dict[str, np.ndarray] = {}
+        for key in self.obs_keys:
+            if key == "panorama":
+                obs[key] = self._panorama.copy()
+            elif key == "omni":
+                obs[key] = self.camera.omni(self._panorama)
+            elif key == "signature":
+                obs[key] = self.camera.signature(self._panorama)
+            elif key == "odometry":
+                obs[key] = self.odometry.estimate.astype(np.float32)
+            elif key in self._goal_obs:
+                obs[key] = self._goal_obs[key].copy()
+        obs.update({k: v for k, v in self.task.extra_observation(self).items()
+                    if k in self.obs_keys})
+        return obs
+
+    def _info(self, collision: bool = False, success: bool = False,
+              rewards: dict[str, float] | None = None) -> dict[str, Any]:
+        return {
+            "pose": self.pose.copy(),
+            "goal_pose": self.episode.home.copy(),
+            "distance_to_goal": self.distance_to_goal,
+            "is_success": bool(success),
+            "collision": bool(collision),
+            "collisions": self.collisions,
+            "rewards": rewards or {},
+        }
+
+    # -- Gymnasium API --------------------------------------------------------------------
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        if self._scene_factory.randomised:
+            self.scene = self._scene_factory.build(self.np_random)
+        self.sim.reset_world(self.scene)
+        self.episode = self.task.sample_episode(self.scene, self.np_random)
+        robot = self.sim.robot
+        robot.set_pose(*self.episode.home)
+        goal = self.render_panorama(self.episode.home)
+        self._goal_obs = {"goal": goal}
+        if "goal_omni" in self.obs_keys:
+            self._goal_obs["goal_omni"] = self.camera.omni(goal)
+        if "goal_signature" in self.obs_keys:
+            self._goal_obs["goal_signature"] = self.camera.signature(goal)
+        robot.set_pose(*self.episode.start)
+        self.pose = robot.pose()
+        self.odometry.reset(to_frame(self.episode.home, self.pose), robot.wheel_angles())
+        self._panorama = self.render_panorama(self.pose)
+        self.trajectory = [(float(self.pose[0]), float(self.pose[1]))]
+        self.collisions = 0
+        self.task.on_reset(self)
+        return self._observation(), self._info()
+
+    def step(self, action):
+        if self.episode is None:
+            raise RuntimeError("call reset() before step()")
+        v, w, stopped = self._command(action)
+        robot = self.sim.robot
+        robot.drive(v * self.robot_config.max_speed, w * self.robot_config.max_yaw_rate)
+        collision = self.sim.step(self.physics_substeps)
+        self.pose = robot.pose()
+        if "odometry" in self.obs_keys:
+            self.odometry.update(robot.wheel_angles(), self.np_random)
+        self._panorama = self.render_panorama(self.pose)
+        self.trajectory.append((float(self.pose[0]), float(self.pose[1])))
+        self.collisions += int(collision)
+        rewards, terminated, success = self.task.step_outcome(self, collision, stopped)
+        reward = float(sum(rewards.values()))
+        if self.render_mode == "human":
+            self.render()
+        return (self._observation(), reward, bool(terminated), False,
+                self._info(collision, success, rewards))
+
+    def render(self):
+        if self.render_mode == "rgb_array":
+            return self.render_frame()
+        if self.render_mode == "human" and self.episode is not None:
+            self.sim.client.resetDebugVisualizerCamera(
+                cameraDistance=2.5, cameraYaw=math.degrees(self.pose[2]) - 90,
+                cameraPitch=-55, cameraTargetPosition=[self.pose[0], self.pose[1], 0])
+        return None
+
+    def render_frame(self) -> np.ndarray:
+        """The ``rgb_array`` picture: top-down map beside current and goal panoramas."""
+        if self.episode is None:
+            raise RuntimeError("call reset() before render()")
+        top = draw_topdown(self.scene, self.pose, self.episode.home, self.trajectory,
+                           robot_radius=self.robot_config.body_radius,
+                           success_radius=getattr(self.task, "success_radius", None))
+        caption = f"(d = {self.distance_to_goal:.2f} m)"
+        return compose_frame(top, self._panorama, self._goal_obs["goal"], caption)
+
+    def close(self):
+        if hasattr(self, "sim"):
+            self.sim.close()

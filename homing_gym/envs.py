@@ -1,0 +1,100 @@
+"""The registered environments. Each class docstring is the env card shown in ``docs/``."""
+
+from __future__ import annotations
+
+from homing_gym.env import HomingEnv
+from homing_gym.scenes.base import Scene
+from homing_gym.tasks.local_homing import LocalHomingTask, RewardConfig
+
+
+class LocalHomingEnv(HomingEnv):
+    """## Description
+
+    Local visual homing. The robot was at a *home* pose and took a panoramic snapshot
+    there (the goal image). It is then put down at a nearby start pose with a random
+    heading and must get back home using what its panoramic camera sees: the classical
+    snapshot-homing problem of insect-inspired navigation (Hong et al. 1991; Franz et al.
+    1998; Yu & Kim 2011). Default scene: ``arena``, Yu & Kim's 2.4 m square with four red
+    cylinders.
+
+    ## Action space
+
+    ``Box(-1, 1, (2,), float32)``: (forward speed, yaw rate), scaled by ``max_speed``
+    (0.3 m/s) and ``max_yaw_rate`` (1.5 rad/s, counter-clockwise positive) and turned into
+    wheel speeds by the unicycle model. Finite values outside ``[-1, 1]`` are clipped; NaN
+    or infinite values raise ``ValueError``. With ``action_type="discrete"``: ``Discrete(4)``,
+    0 forward at full speed, 1 turn left, 2 turn right, 3 stop. Each action is held for one
+    control period of ``control_period`` = 0.1 s, simulated in ``physics_substeps`` = 24
+    physics steps of 1/240 s.
+
+    ## Observation space
+
+    ``Dict`` with the keys listed in ``obs_keys`` (default ``("panorama", "goal")``):
+
+    | key | space | meaning |
+    |---|---|---|
+    | `panorama` | `Box(0, 255, (H, W, 3), uint8)` | current cylindrical panorama, default 48 x 256 (1.41 deg/column, 1.25 deg/row) |
+    | `goal` | same | panorama taken at the home pose |
+    | `omni`, `goal_omni` | `Box(0, 255, (S, S, 3), uint8)` | catadioptric ring images, default S = 128 |
+    | `signature`, `goal_signature` | `Box(0, 1, (W,), float32)` | Hong 1991 horizon signatures |
+    | `odometry` | `Box(-inf, inf, (3,), float32)` | wheel-encoder path integration: pose (x, y, yaw) in the home frame |
+
+    Panorama convention: column ``x`` in ``[0, W)`` has bearing ``pi - 2*pi*x/W`` (radians,
+    counter-clockwise from the heading): straight ahead at the centre column, directly
+    behind at the edges, the horizon at row ``H/2``. See :mod:`homing_gym.panorama`.
+    ``odometry`` starts at the true start pose relative to home (as if the robot had driven
+    out from home) and then integrates the wheel encoders, each increment scaled by
+    ``1 + N(0, odometry_noise)``.
+
+    ## Rewards
+
+    ``progress * (d_prev - d)`` (potential-based, ``d`` the distance to home in metres)
+    ``+ success`` once on success ``- collision`` on each step with contact
+    ``- time`` on each step; defaults 1.0, 10.0, 0.1, 0.01 (see ``RewardConfig``). Each
+    term is reported in ``info["rewards"]``.
+
+    ## Starting state
+
+    Home: a uniformly drawn pose with at least 0.22 m of clearance from walls and
+    landmarks. Start: at a distance drawn uniformly from ``start_distance`` = (0.3, 1.5) m
+    in a random direction from home, also collision-free, with a uniform random heading.
+    Everything is drawn from the generator seeded by ``reset(seed=...)``.
+
+    ## Episode end
+
+    Terminated on success: with ``success_on="reach"`` (default) when the robot centre is
+    within ``success_radius`` = 0.15 m of home; with ``success_on="stop"`` when the agent
+    issues stop (discrete action 3, or a continuous action with both components below
+    ``stop_threshold`` = 0.05 in magnitude), a success if it stopped within
+    ``success_radius``. Truncated after ``max_episode_steps`` = 500 steps (50 s).
+
+    ## Info
+
+    ``pose`` and ``goal_pose`` (x, y, yaw; metres, radians), ``distance_to_goal`` (m),
+    ``is_success``, ``collision`` (contact this step), ``collisions`` (steps with contact
+    so far), ``rewards`` (the reward terms). Ground truth: for metrics, not for agents.
+
+    ## Arguments
+
+    ``gym.make("homing_gym/LocalHoming-v0", **kwargs)`` with: ``scene`` (``"arena"``,
+    ``"random_arena"`` or a :class:`~homing_gym.scenes.Scene`), ``render_mode``
+    (``None``, ``"rgb_array"``: top-down map beside current and goal panoramas;
+    ``"human"``: PyBullet GUI), ``obs_keys``, ``panorama_shape`` = (48, 256),
+    ``vfov_deg`` = 60, ``n_views`` = 6, ``renderer`` (``"tiny"`` or ``"egl"``), ``omni_size`` = 128,
+    ``action_type``, ``control_period``, ``physics_substeps``, ``max_speed``,
+    ``max_yaw_rate``, ``stop_threshold``, ``odometry_noise`` = 0.02,
+    ``start_distance``, ``success_radius``, ``success_on``, ``reward`` (a
+    ``RewardConfig``), ``max_episode_steps``.
+
+    ## Version history
+
+    * v0: initial release.
+    """
+
+    def __init__(self, scene: str | Scene = "arena", *,
+                 start_distance: tuple[float, float] = (0.3, 1.5),
+                 success_radius: float = 0.15, success_on: str = "reach",
+                 reward: RewardConfig = RewardConfig(), **kwargs):
+        task = LocalHomingTask(start_distance=start_distance, success_radius=success_radius,
+                               success_on=success_on, reward=reward)
+        super().__init__(task, scene, **kwargs)

@@ -1,0 +1,237 @@
+"""The panoramic camera: cylindrical panorama, catadioptric ring image, horizon signature.
+
+Conventions (tested in ``tests/test_panorama.py``):
+
+* Panorama: uint8 ``(H, W, 3)``, the full 360 degrees. The continuous column coordinate
+  ``x`` runs over ``[0, W)``; pixel column ``j`` covers ``[j, j + 1)``, centre ``j + 0.5``.
+  Bearing (radians, counter-clockwise from the robot's heading)
+  ``beta(x) = pi - 2*pi*x/W``: straight ahead at ``x = W/2``, the robot's left
+  (``beta = pi/2``) at ``x = W/4``, left of centre; directly behind at ``x = 0`` (= ``W``).
+* Rows are equiangular in elevation: ``elevation(y) = vfov/2 - vfov*y/H`` for the
+  continuous row coordinate ``y`` in ``[0, H)``; the horizon is at ``y = H/2``, the
+  boundary between rows ``H/2 - 1`` and ``H/2``. The default vertical field of view is
+  60 degrees (+-30 about the horizon).
+* ``omni`` ring image (square ``S x S``), what a camera looking at a convex mirror sees
+  (Hong et al. 1991 §2, Yu & Kim §III), drawn as seen from above: the robot's heading points
+  up (towards row 0), bearings run counter-clockwise in the image, elevation grows with the
+  radius from ``-vfov/2`` at ``r_in = 0.25*S/2`` to ``+vfov/2`` at ``r_out = 0.98*S/2``;
+  the horizon is the circle of radius ``(r_in + r_out)/2`` about the image centre
+  ``(S/2, S/2)``. Outside the ring the image is black.
+* ``signature``: Hong 1991 §2's one-dimensional location signature, one value per column,
+  the luminance in ``[0, 1]`` averaged over ``signature_rows`` samples spaced one row apart
+  and centred on the horizon (linear interpolation between rows).
+
+The panorama is rendered by PyBullet from ``n_views`` perspective cameras at the camera
+centre, facing evenly spaced yaws, and resampled into the cylinder with a single
+precomputed ``cv2.remap``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+import pybullet as p
+from pybullet_utils.bullet_client import BulletClient
+
+RENDERERS = ("tiny", "egl")
+LUMA = np.array([0.299, 0.587, 0.114], dtype=np.float32)
+OMNI_INNER, OMNI_OUTER = 0.25, 0.98
+
+
+def column_bearing(x, width: int):
+    """Bearing (radians, CCW from heading) of continuous column coordinate ``x``."""
+    return np.pi - 2 * np.pi * np.asarray(x, dtype=np.float64) / width
+
+
+def bearing_column(beta, width: int):
+    """Continuous column coordinate in ``[0, W)`` of bearing ``beta`` (radians, CCW)."""
+    return np.mod((np.pi - np.asarray(beta, dtype=np.float64)) * width / (2 * np.pi), width)
+
+
+def row_elevation(y, height: int, vfov: float):
+    """Elevation (radians, up positive) of continuous row coordinate ``y``."""
+    return vfov / 2 - vfov * np.asarray(y, dtype=np.float64) / height
+
+
+@dataclass(frozen=True)
+class CameraConfig:
+    """Panoramic camera settings.
+
+    ``panorama_shape`` is ``(H, W)`` in pixels; the angular resolution is ``360/W`` degrees
+    per column (default 1.41 deg; ``W = 360`` gives 1 deg) and ``vfov/H`` per row (default
+    1.25 deg). ``n_views`` perspective renders are resampled; 6 was the fastest of 4, 6, 8
+    for the default shape (``python -m homing_gym.benchmark``).
+    ``vfov`` is the full vertical field of view in radians, symmetric about the horizon.
+    """
+
+    panorama_shape: tuple[int, int] = (48, 256)
+    vfov: float = math.radians(60)
+    n_views: int = 6
+    near: float = 0.02
+    far: float = 30.0
+    omni_size: int = 128
+    signature_rows: int = 5
+    renderer: str = "tiny"
+
+    def __post_init__(self) -> None:
+        shape = self.panorama_shape
+        if (len(shape) != 2 or not all(isinstance(v, (int, np.integer)) for v in shape)
+                or not (8 <= shape[0] <= 1024 and 16 <= shape[1] <= 4096)):
+            raise ValueError(f"panorama_shape must be (H, W) integers with 8 <= H <= 1024 and "
+                             f"16 <= W <= 4096, got {shape!r}")
+        if not (math.radians(10) <= self.vfov <= math.radians(120)):
+            raise ValueError(f"vfov must lie in [10, 120] degrees (given in radians), got "
+                             f"{self.vfov!r} rad = {math.degrees(self.vfov):.1f} deg")
+        if self.n_views not in (3, 4, 6, 8):
+            raise ValueError(f"n_views must be one of (3, 4, 6, 8), got {self.n_views!r}")
+        if not (16 <= self.omni_size <= 2048):
+            raise ValueError(f"omni_size must be in [16, 2048] pixels, got {self.omni_size!r}")
+        if not (1 <= self.signature_rows <= shape[0] - 2):
+            raise ValueError(f"signature_rows must be in [1, H - 2] = [1, {shape[0] - 2}], "
+                             f"got {self.signature_rows!r}")
+        if self.renderer not in RENDERERS:
+            raise ValueError(f"unknown renderer {self.renderer!r}; allowed: {RENDERERS}")
+        if not (0 < self.near < self.far):
+            raise ValueError(f"need 0 < near < far, got near={self.near!r}, far={self.far!r}")
+
+
+@dataclass(frozen=True)
+class ViewGeometry:
+    """Size and intrinsics of the perspective views the panorama is resampled from."""
+
+    width: int
+    height: int
+    focal: float
+    yaws: tuple[float, ...]
+
+    @property
+    def vfov_degrees(self) -> float:
+        return math.degrees(2 * math.atan(self.height / 2 / self.focal))
+
+
+def view_geometry(config: CameraConfig) -> ViewGeometry:
+    """Perspective views with square pixels, at least as dense as the panorama at their
+    centre, covering their azimuth sector plus a 2-pixel margin for interpolation."""
+    H, W = config.panorama_shape
+    n = config.n_views
+    focal = max(W / (2 * np.pi), H / config.vfov)
+    half_h = np.pi / n + 2.0 / focal
+    width = 2 * math.ceil(focal * math.tan(half_h))
+    height = 2 * math.ceil(focal * math.tan(config.vfov / 2) / math.cos(np.pi / n) + 2)
+    yaws = tuple(2 * np.pi * k / n for k in range(n))
+    return ViewGeometry(width=width, height=height, focal=focal, yaws=yaws)
+
+
+def panorama_maps(config: CameraConfig, geom: ViewGeometry) -> tuple[np.ndarray, np.ndarray]:
+    """``cv2.remap`` maps from the side-by-side views ``(h, n*w)`` to the panorama ``(H, W)``."""
+    H, W = config.panorama_shape
+    beta = column_bearing(np.arange(W) + 0.5, W)[None, :].repeat(H, 0)
+    elev = row_elevation(np.arange(H) + 0.5, H, config.vfov)[:, None].repeat(W, 1)
+    n = config.n_views
+    view = np.mod(np.round(beta / (2 * np.pi / n)), n).astype(int)
+    rel = beta - np.asarray(geom.yaws)[view]
+    # direction in the view's frame: forward, left, up
+    fwd = np.cos(elev) * np.cos(rel)
+    left = np.cos(elev) * np.sin(rel)
+    up = np.sin(elev)
+    u = geom.width / 2 - geom.focal * left / fwd          # continuous pixel coordinates
+    v = geom.height / 2 - geom.focal * up / fwd
+    map_x = (u - 0.5 + view * geom.width).astype(np.float32)
+    map_y = (v - 0.5).astype(np.float32)
+    return map_x, map_y
+
+
+def omni_maps(config: CameraConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``cv2.remap`` maps from the column-padded panorama ``(H, W + 2)`` to the ring image,
+    and the boolean mask of ring pixels."""
+    H, W = config.panorama_shape
+    S = config.omni_size
+    c = (np.arange(S) + 0.5) - S / 2
+    dx, dy = np.meshgrid(c, c)
+    r = np.hypot(dx, dy)
+    r_in, r_out = OMNI_INNER * S / 2, OMNI_OUTER * S / 2
+    beta = np.arctan2(-dx, -dy)
+    elev = -config.vfov / 2 + config.vfov * (r - r_in) / (r_out - r_in)
+    x = bearing_column(beta, W)
+    y = (config.vfov / 2 - elev) / config.vfov * H
+    mask = (r >= r_in) & (r <= r_out)
+    return (x - 0.5 + 1).astype(np.float32), (y - 0.5).astype(np.float32), mask
+
+
+def omni_horizon_radius(omni_size: int) -> float:
+    """Radius (pixels) of the horizon circle in the ``omni`` ring image."""
+    return (OMNI_INNER + OMNI_OUTER) / 2 * omni_size / 2
+
+
+def signature_weights(height: int, rows: int) -> np.ndarray:
+    """Row weights (sum 1) that average ``rows`` samples one row apart centred on the
+    horizon ``y = H/2``, each sample linearly interpolated between pixel rows."""
+    weights = np.zeros(height)
+    for k in range(rows):
+        y = height / 2 + k - (rows - 1) / 2 - 0.5       # sample position in row-centre units
+        lo = math.floor(y)
+        frac = y - lo
+        weights[lo] += 1 - frac
+        weights[min(lo + 1, height - 1)] += frac
+    return (weights / rows).astype(np.float32)
+
+
+class PanoramaCamera:
+    """Renders panoramas at a robot pose and derives the ``omni`` and ``signature`` views."""
+
+    def __init__(self, config: CameraConfig = CameraConfig(), camera_height: float = 0.30):
+        self.config = config
+        self.camera_height = camera_height
+        self.geometry = view_geometry(config)
+        self._map_x, self._map_y = panorama_maps(config, self.geometry)
+        self._omni_x, self._omni_y, self._omni_mask = omni_maps(config)
+        self._sig_weights = signature_weights(config.panorama_shape[0], config.signature_rows)
+        g = self.geometry
+        self._views = np.empty((g.height, g.width * config.n_views, 3), np.uint8)
+        self._projection = p.computeProjectionMatrixFOV(
+            fov=g.vfov_degrees, aspect=g.width / g.height, nearVal=config.near,
+            farVal=config.far)
+
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        return (*self.config.panorama_shape, 3)
+
+    def render_views(self, client: BulletClient, pose, renderer: int) -> np.ndarray:
+        """The ``n_views`` perspective images side by side, uint8 ``(h, n*w, 3)``."""
+        g = self.geometry
+        x, y, yaw = float(pose[0]), float(pose[1]), float(pose[2])
+        eye = [x, y, self.camera_height]
+        for k, view_yaw in enumerate(g.yaws):
+            a = yaw + view_yaw
+            target = [x + math.cos(a), y + math.sin(a), self.camera_height]
+            view = client.computeViewMatrix(eye, target, [0, 0, 1])
+            _, _, rgba, _, _ = client.getCameraImage(
+                g.width, g.height, view, self._projection, renderer=renderer,
+                shadow=0, lightDirection=[0.4, 0.3, 1.0], lightAmbientCoeff=0.6,
+                lightDiffuseCoeff=0.45, lightSpecularCoeff=0.05,
+                flags=p.ER_NO_SEGMENTATION_MASK)
+            rgba = np.asarray(rgba, dtype=np.uint8).reshape(g.height, g.width, 4)
+            self._views[:, k * g.width:(k + 1) * g.width] = rgba[..., :3]
+        return self._views
+
+    def render(self, client: BulletClient, pose, renderer: int) -> np.ndarray:
+        """Panorama at ``pose = (x, y, yaw)`` (metres, radians): uint8 ``(H, W, 3)``."""
+        views = self.render_views(client, pose, renderer)
+        return cv2.remap(views, self._map_x, self._map_y, cv2.INTER_LINEAR,
+                         borderMode=cv2.BORDER_REPLICATE)
+
+    def omni(self, panorama: np.ndarray) -> np.ndarray:
+        """The catadioptric ring image of a panorama: uint8 ``(S, S, 3)``."""
+        padded = np.concatenate([panorama[:, -1:], panorama, panorama[:, :1]], axis=1)
+        ring = cv2.remap(padded, self._omni_x, self._omni_y, cv2.INTER_LINEAR,
+                         borderMode=cv2.BORDER_REPLICATE)
+        ring[~self._omni_mask] = 0
+        return ring
+
+    def signature(self, panorama: np.ndarray) -> np.ndarray:
+        """Hong 1991 §2 horizon signature: float32 ``(W,)`` luminance in ``[0, 1]``."""
+        gray = panorama.astype(np.float32) @ LUMA
+        return (self._sig_weights @ gray) / 255.0

@@ -1,0 +1,144 @@
+"""The differential-drive robot: URDF loading, unicycle control and wheel odometry.
+
+Frame conventions (used everywhere in homing-gym): world x, y on the floor, z up;
+a pose is ``(x, y, yaw)`` in metres and radians, yaw counter-clockwise from world +x.
+The robot's own frame has x forward, y to the left.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from importlib import resources
+
+import numpy as np
+import pybullet as p
+from pybullet_utils.bullet_client import BulletClient
+
+from homing_gym.geometry import wrap_angle
+
+URDF_PATH = str(resources.files("homing_gym") / "assets" / "robot.urdf")
+
+
+@dataclass(frozen=True)
+class RobotConfig:
+    """Physical constants of the robot (metres, seconds, radians).
+
+    ``max_speed`` and ``max_yaw_rate`` scale the normalised action ``(v, w) in [-1, 1]^2``.
+    """
+
+    body_radius: float = 0.16
+    wheel_radius: float = 0.035
+    wheel_separation: float = 0.23
+    camera_height: float = 0.30
+    base_height: float = 0.055
+    max_speed: float = 0.3
+    max_yaw_rate: float = 1.5
+    wheel_torque: float = 2.0
+
+    @property
+    def max_wheel_speed(self) -> float:
+        """Largest wheel angular speed (rad/s) the unicycle model can ask for."""
+        return (self.max_speed + self.max_yaw_rate * self.wheel_separation / 2) / self.wheel_radius
+
+
+def wheel_speeds(v: float, w: float, config: RobotConfig) -> tuple[float, float]:
+    """Unicycle model: forward speed ``v`` (m/s) and yaw rate ``w`` (rad/s, CCW)
+    to (left, right) wheel angular speeds in rad/s."""
+    half = config.wheel_separation / 2
+    return (v - w * half) / config.wheel_radius, (v + w * half) / config.wheel_radius
+
+
+class Robot:
+    """The robot body inside one :class:`~homing_gym.simulator.Simulator` client."""
+
+    def __init__(self, client: BulletClient, config: RobotConfig = RobotConfig()):
+        self.client = client
+        self.config = config
+        self.body_id = client.loadURDF(URDF_PATH, [0, 0, config.base_height], useFixedBase=False)
+        names = {
+            client.getJointInfo(self.body_id, j)[1].decode(): j
+            for j in range(client.getNumJoints(self.body_id))
+        }
+        self.wheel_joints = [names["left_wheel_joint"], names["right_wheel_joint"]]
+        self.caster_link = names["caster_joint"]
+        self.camera_link = names["camera_joint"]
+        for j in self.wheel_joints:
+            client.changeDynamics(self.body_id, j, lateralFriction=1.0, spinningFriction=0.0,
+                                  rollingFriction=0.0)
+        client.changeDynamics(self.body_id, self.caster_link, lateralFriction=0.0,
+                              spinningFriction=0.0, rollingFriction=0.0)
+        client.changeDynamics(self.body_id, -1, lateralFriction=0.3)
+        # PyBullet places a base by its centre of mass; keep the URDF link frame instead.
+        info = client.getDynamicsInfo(self.body_id, -1)
+        self._com_in_link = (info[3], info[4])
+        self._link_in_com = client.invertTransform(*self._com_in_link)
+
+    def set_pose(self, x: float, y: float, yaw: float) -> None:
+        """Teleport the robot to a pose on the floor, at rest."""
+        quat = self.client.getQuaternionFromEuler([0.0, 0.0, yaw])
+        pos, orn = self.client.multiplyTransforms(
+            [x, y, self.config.base_height], quat, *self._com_in_link)
+        self.client.resetBasePositionAndOrientation(self.body_id, pos, orn)
+        self.client.resetBaseVelocity(self.body_id, [0, 0, 0], [0, 0, 0])
+        for j in self.wheel_joints:
+            self.client.resetJointState(self.body_id, j, 0.0, 0.0)
+        self.drive(0.0, 0.0)
+
+    def drive(self, v: float, w: float) -> None:
+        """Command forward speed ``v`` (m/s) and yaw rate ``w`` (rad/s) to the wheel motors."""
+        left, right = wheel_speeds(v, w, self.config)
+        self.client.setJointMotorControlArray(
+            self.body_id, self.wheel_joints, p.VELOCITY_CONTROL,
+            targetVelocities=[left, right], forces=[self.config.wheel_torque] * 2)
+
+    def pose(self) -> np.ndarray:
+        """True pose ``(x, y, yaw)`` of the body centre on the floor (float64)."""
+        pos, quat = self.client.multiplyTransforms(
+            *self.client.getBasePositionAndOrientation(self.body_id), *self._link_in_com)
+        yaw = self.client.getEulerFromQuaternion(quat)[2]
+        return np.array([pos[0], pos[1], yaw])
+
+    def wheel_angles(self) -> np.ndarray:
+        """Encoder readings: (left, right) wheel joint angles in radians."""
+        states = self.client.getJointStates(self.body_id, self.wheel_joints)
+        return np.array([s[0] for s in states])
+
+
+class WheelOdometry:
+    """Path integration from wheel encoders (dead reckoning), as insects do (Yu & Kim §I).
+
+    Each control step the encoder increments of both wheels are multiplied by
+    ``1 + N(0, noise)`` (independent per wheel and step: slip and tyre wear), turned into
+    a forward displacement and a heading change by the differential-drive model, and
+    integrated with the midpoint rule. The estimate is a pose ``(x, y, yaw)`` in the
+    home frame: origin at home, x along the home heading, y to its left.
+    """
+
+    def __init__(self, config: RobotConfig, noise: float):
+        if not np.isfinite(noise) or noise < 0:
+            raise ValueError(f"odometry_noise must be a finite number >= 0, got {noise!r}")
+        self.config = config
+        self.noise = noise
+        self.estimate = np.zeros(3)
+        self._last_angles = np.zeros(2)
+
+    def reset(self, initial: np.ndarray, wheel_angles: np.ndarray) -> None:
+        """Start integrating from ``initial`` (home-frame pose) at the given encoder angles."""
+        self.estimate = np.asarray(initial, dtype=np.float64).copy()
+        self._last_angles = wheel_angles.copy()
+
+    def update(self, wheel_angles: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        """Integrate the encoder change since the last call; returns the new estimate."""
+        delta = (wheel_angles - self._last_angles) * self.config.wheel_radius
+        self._last_angles = wheel_angles.copy()
+        if self.noise > 0:
+            delta = delta * (1.0 + rng.normal(0.0, self.noise, size=2))
+        ds = float(delta.mean())
+        dyaw = float(delta[1] - delta[0]) / self.config.wheel_separation
+        mid = self.estimate[2] + dyaw / 2
+        self.estimate = np.array([
+            self.estimate[0] + ds * np.cos(mid),
+            self.estimate[1] + ds * np.sin(mid),
+            wrap_angle(self.estimate[2] + dyaw),
+        ])
+        return self.estimate

@@ -1,0 +1,60 @@
+"""Scenes: declarative worlds and the registry that names them.
+
+A scene name maps to a :class:`SceneFactory`. Fixed scenes return the same
+:class:`Scene` every episode; randomised scenes draw a new one from the episode's random
+generator. Add a scene with :func:`register_scene`; the env core needs no change.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from homing_gym.scenes.arena import arena_scene
+from homing_gym.scenes.base import SHAPES, Landmark, Scene, Wall, square_walls
+from homing_gym.scenes.random_arena import random_arena_scene
+
+
+@dataclass(frozen=True)
+class SceneFactory:
+    """How to obtain a scene: ``build(rng)`` returns it; ``randomised`` says whether it
+    changes from episode to episode (then ``build`` is called at every reset)."""
+
+    build: Callable[[np.random.Generator], Scene]
+    randomised: bool = False
+    description: str = ""
+
+
+_SCENES: dict[str, SceneFactory] = {}
+
+
+def register_scene(name: str, factory: SceneFactory) -> None:
+    """Make ``name`` usable as ``gym.make(..., scene=name)``."""
+    _SCENES[name] = factory
+
+
+def available_scenes() -> list[str]:
+    """Names of the registered scenes."""
+    return sorted(_SCENES)
+
+
+def scene_factory(scene: str | Scene) -> SceneFactory:
+    """The factory for a scene name, or a fixed factory around a :class:`Scene` object."""
+    if isinstance(scene, Scene):
+        return SceneFactory(build=lambda rng, s=scene: s, description=scene.name)
+    if scene not in _SCENES:
+        raise ValueError(f"unknown scene {scene!r}; allowed: {available_scenes()}")
+    return _SCENES[scene]
+
+
+register_scene("arena", SceneFactory(
+    build=lambda rng: arena_scene(),
+    description="Yu & Kim arena: 2.4 m square, four red cylinders"))
+register_scene("random_arena", SceneFactory(
+    build=random_arena_scene, randomised=True,
+    description="2.4 m square, 3-8 random landmarks and textures per episode"))
+
+__all__ = ["SHAPES", "Landmark", "Scene", "SceneFactory", "Wall", "available_scenes",
+           "register_scene", "scene_factory", "square_walls"]

@@ -1,0 +1,153 @@
+"""The PyBullet world of one env: its own client, the scene bodies, the robot, state resets.
+
+Every env owns one :class:`Simulator`, and every call goes through its
+``pybullet_utils.bullet_client.BulletClient``, so several envs in one process never share
+state. The world is built once; :meth:`Simulator.reset_world` restores a saved snapshot
+(``saveState``/``restoreState``) instead of reloading URDFs. Only a randomised scene that
+changes its landmarks rebuilds those primitive bodies (no URDF loading).
+
+Physics: ``time_step`` (default 1/240 s) per ``stepSimulation``; the env runs
+``substeps`` of them per control period.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pybullet as p
+from pybullet_utils.bullet_client import BulletClient
+
+from homing_gym.robot import Robot, RobotConfig
+from homing_gym.scenes.base import Landmark, Scene, Wall
+from homing_gym.textures import texture_path
+
+FLOOR_MARGIN = 2.0
+
+
+class Simulator:
+    """One PyBullet client holding a scene and the robot."""
+
+    def __init__(self, scene: Scene, *, gui: bool = False, time_step: float = 1 / 240,
+                 robot_config: RobotConfig = RobotConfig()):
+        self.client = BulletClient(connection_mode=p.GUI if gui else p.DIRECT)
+        self._connected = True
+        c = self.client
+        c.setGravity(0, 0, -9.81)
+        c.setTimeStep(time_step)
+        c.setPhysicsEngineParameter(deterministicOverlappingPairs=1)
+        if gui:
+            c.configureDebugVisualizer(p.COV_ENABLE_GUI, 0)
+        self.time_step = time_step
+        self._textures: dict[str, int] = {}
+        self.scene = scene
+        self.floor_id = self._make_floor(scene)
+        self.wall_ids = [self._make_wall(w) for w in scene.walls]
+        self.robot = Robot(c, robot_config)
+        self._bare_state = c.saveState()
+        self.landmark_ids = [self._make_landmark(lm) for lm in scene.landmarks]
+        self._state = c.saveState()
+        self.obstacle_ids = frozenset(self.wall_ids + self.landmark_ids)
+
+    # -- building -------------------------------------------------------------------------
+    def _texture(self, name: str | None) -> int | None:
+        if name is None:
+            return None
+        if name not in self._textures:
+            self._textures[name] = self.client.loadTexture(texture_path(name))
+        return self._textures[name]
+
+    def _paint(self, body: int, color, texture: str | None) -> None:
+        tex = self._texture(texture)
+        self.client.changeVisualShape(body, -1, rgbaColor=list(color),
+                                      textureUniqueId=-1 if tex is None else tex)
+
+    def _box(self, half_extents, position, yaw: float, color, texture) -> int:
+        c = self.client
+        col = c.createCollisionShape(p.GEOM_BOX, halfExtents=half_extents)
+        vis = c.createVisualShape(p.GEOM_BOX, halfExtents=half_extents, rgbaColor=list(color))
+        body = c.createMultiBody(0, col, vis, position, c.getQuaternionFromEuler([0, 0, yaw]))
+        self._paint(body, color, texture)
+        return body
+
+    def _make_floor(self, scene: Scene) -> int:
+        (xmin, ymin), (xmax, ymax) = scene.bounds
+        half = [(xmax - xmin) / 2 + FLOOR_MARGIN, (ymax - ymin) / 2 + FLOOR_MARGIN, 0.05]
+        centre = [(xmin + xmax) / 2, (ymin + ymax) / 2, -0.05]
+        c = self.client
+        col = c.createCollisionShape(p.GEOM_PLANE)
+        vis = c.createVisualShape(p.GEOM_BOX, halfExtents=half, visualFramePosition=centre,
+                                  rgbaColor=list(scene.floor_color))
+        body = c.createMultiBody(0, col, vis, [0, 0, 0])
+        self._paint(body, scene.floor_color, scene.floor_texture)
+        c.changeDynamics(body, -1, lateralFriction=1.0)
+        return body
+
+    def _make_wall(self, wall: Wall) -> int:
+        (x0, y0), (x1, y1) = wall.start, wall.end
+        half = [(wall.length + wall.thickness) / 2, wall.thickness / 2, wall.height / 2]
+        yaw = math.atan2(y1 - y0, x1 - x0)
+        return self._box(half, [(x0 + x1) / 2, (y0 + y1) / 2, wall.height / 2], yaw,
+                         wall.color, wall.texture)
+
+    def _make_landmark(self, lm: Landmark) -> int:
+        position = [lm.position[0], lm.position[1], lm.height / 2]
+        if lm.shape == "box":
+            half = [lm.extent[0] / 2, lm.extent[1] / 2, lm.height / 2]
+            return self._box(half, position, lm.yaw, lm.color, lm.texture)
+        c = self.client
+        col = c.createCollisionShape(p.GEOM_CYLINDER, radius=lm.radius, height=lm.height)
+        vis = c.createVisualShape(p.GEOM_CYLINDER, radius=lm.radius, length=lm.height,
+                                  rgbaColor=list(lm.color))
+        body = c.createMultiBody(0, col, vis, position,
+                                 c.getQuaternionFromEuler([0, 0, lm.yaw]))
+        self._paint(body, lm.color, lm.texture)
+        return body
+
+    # -- episodes -------------------------------------------------------------------------
+    def reset_world(self, scene: Scene) -> None:
+        """Bring the world back to its saved state, switching to ``scene`` if it differs.
+
+        ``scene`` must have the same walls' geometry as the one the simulator was built
+        with (randomised scenes change landmarks and textures only).
+        """
+        c = self.client
+        if scene == self.scene:
+            c.restoreState(self._state)
+            return
+        if len(scene.walls) != len(self.wall_ids):
+            raise ValueError(f"scene {scene.name!r} has {len(scene.walls)} walls; this "
+                             f"simulator was built with {len(self.wall_ids)}")
+        for body in self.landmark_ids:
+            c.removeBody(body)
+        c.removeState(self._state)
+        c.restoreState(self._bare_state)
+        for body, wall in zip(self.wall_ids, scene.walls):
+            self._paint(body, wall.color, wall.texture)
+        self._paint(self.floor_id, scene.floor_color, scene.floor_texture)
+        self.landmark_ids = [self._make_landmark(lm) for lm in scene.landmarks]
+        self._state = c.saveState()
+        self.obstacle_ids = frozenset(self.wall_ids + self.landmark_ids)
+        self.scene = scene
+
+    def step(self, substeps: int) -> bool:
+        """Advance the physics ``substeps`` times; True if the robot touched an obstacle."""
+        touched = False
+        for _ in range(substeps):
+            self.client.stepSimulation()
+            touched = touched or self.robot_in_contact()
+        return touched
+
+    def robot_in_contact(self) -> bool:
+        """True if the robot currently touches a wall or landmark (the floor does not count)."""
+        contacts = self.client.getContactPoints(bodyA=self.robot.body_id)
+        return any(cp[2] in self.obstacle_ids for cp in contacts)
+
+    def close(self) -> None:
+        """Disconnect the client; safe to call more than once."""
+        if self._connected:
+            self._connected = False
+            self.client.disconnect()
+
+    @property
+    def connected(self) -> bool:
+        return self._connected

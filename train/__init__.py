@@ -1,0 +1,1 @@
+"""Training and evaluation of policies (filled in by later issues)."""
