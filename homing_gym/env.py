@@ -93,6 +93,7 @@ class HomingEnv(gym.Env):
         self.odometry = WheelOdometry(self.robot_config, odometry_noise)
         self._scene_factory = scene_factory(scene)
         self.scene = self._scene_factory.build(np.random.default_rng(0))
+        task.check_scene(self.scene)
         self.sim = Simulator(self.scene, gui=render_mode == "human",
                              time_step=self.control_period / self.physics_substeps,
                              robot_config=self.robot_config)

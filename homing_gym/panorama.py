@@ -137,10 +137,12 @@ def panorama_maps(config: CameraConfig, geom: ViewGeometry) -> tuple[np.ndarray,
     fwd = np.cos(elev) * np.cos(rel)
     left = np.cos(elev) * np.sin(rel)
     up = np.sin(elev)
-    u = geom.width / 2 - geom.focal * left / fwd          # continuous pixel coordinates
+    # PyBullet's renderer samples pixel i at image coordinate i (no half-pixel offset,
+    # measured with the pole test), so these are directly the remap coordinates.
+    u = geom.width / 2 - geom.focal * left / fwd
     v = geom.height / 2 - geom.focal * up / fwd
-    map_x = (u - 0.5 + view * geom.width).astype(np.float32)
-    map_y = (v - 0.5).astype(np.float32)
+    map_x = (u + view * geom.width).astype(np.float32)
+    map_y = v.astype(np.float32)
     return map_x, map_y
 
 

@@ -24,6 +24,9 @@ class RobotConfig:
     """Physical constants of the robot (metres, seconds, radians).
 
     ``max_speed`` and ``max_yaw_rate`` scale the normalised action ``(v, w) in [-1, 1]^2``.
+    The motor controller ramps each wheel's rim speed by at most ``wheel_acceleration``
+    (m/s^2), as real drive controllers do; without the ramp, abrupt command changes make
+    the wheels slip and the encoders lie.
     """
 
     body_radius: float = 0.16
@@ -34,6 +37,7 @@ class RobotConfig:
     max_speed: float = 0.3
     max_yaw_rate: float = 1.5
     wheel_torque: float = 2.0
+    wheel_acceleration: float = 2.0
 
     @property
     def max_wheel_speed(self) -> float:
@@ -82,14 +86,25 @@ class Robot:
         self.client.resetBaseVelocity(self.body_id, [0, 0, 0], [0, 0, 0])
         for j in self.wheel_joints:
             self.client.resetJointState(self.body_id, j, 0.0, 0.0)
+        self._current = np.zeros(2)
         self.drive(0.0, 0.0)
+        self.update_motors(0.0)
+        # Refresh the contact cache at the new pose: without this, contacts remembered from
+        # before the teleport make the next steps depend on the previous episode.
+        self.client.performCollisionDetection()
 
     def drive(self, v: float, w: float) -> None:
-        """Command forward speed ``v`` (m/s) and yaw rate ``w`` (rad/s) to the wheel motors."""
-        left, right = wheel_speeds(v, w, self.config)
+        """Command forward speed ``v`` (m/s) and yaw rate ``w`` (rad/s); the wheel motors
+        ramp towards it in :meth:`update_motors`."""
+        self._target = np.array(wheel_speeds(v, w, self.config))
+
+    def update_motors(self, dt: float) -> None:
+        """Move the wheel motor targets towards the command by one ramp step of ``dt`` s."""
+        limit = self.config.wheel_acceleration / self.config.wheel_radius * dt
+        self._current = self._current + np.clip(self._target - self._current, -limit, limit)
         self.client.setJointMotorControlArray(
             self.body_id, self.wheel_joints, p.VELOCITY_CONTROL,
-            targetVelocities=[left, right], forces=[self.config.wheel_torque] * 2)
+            targetVelocities=self._current.tolist(), forces=[self.config.wheel_torque] * 2)
 
     def pose(self) -> np.ndarray:
         """True pose ``(x, y, yaw)`` of the body centre on the floor (float64)."""

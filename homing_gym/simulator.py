@@ -34,7 +34,7 @@ class Simulator:
         c = self.client
         c.setGravity(0, 0, -9.81)
         c.setTimeStep(time_step)
-        c.setPhysicsEngineParameter(deterministicOverlappingPairs=1)
+        c.setPhysicsEngineParameter(deterministicOverlappingPairs=1, numSolverIterations=10)
         if gui:
             c.configureDebugVisualizer(p.COV_ENABLE_GUI, 0)
         self.time_step = time_step
@@ -133,6 +133,7 @@ class Simulator:
         """Advance the physics ``substeps`` times; True if the robot touched an obstacle."""
         touched = False
         for _ in range(substeps):
+            self.robot.update_motors(self.time_step)
             self.client.stepSimulation()
             touched = touched or self.robot_in_contact()
         return touched

@@ -35,6 +35,9 @@ class Task(ABC):
     def sample_episode(self, scene: Scene, rng: np.random.Generator) -> Episode:
         """Draw home and start poses for a new episode."""
 
+    def check_scene(self, scene: Scene) -> None:
+        """Raise ``ValueError`` if the task's settings cannot be met in ``scene``."""
+
     def on_reset(self, env: "HomingEnv") -> None:
         """Called at the end of ``env.reset``, once the robot stands at the start."""
 

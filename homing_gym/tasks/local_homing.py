@@ -58,6 +58,15 @@ class LocalHomingTask(Task):
         self.clearance_margin = clearance_margin
         self._prev_distance = 0.0
 
+    def check_scene(self, scene: Scene) -> None:
+        width, depth = scene.size
+        reach = math.hypot(width, depth) - 2 * self.clearance_margin
+        if self.start_distance[1] > reach:
+            raise ValueError(
+                f"start_distance {self.start_distance} m does not fit into scene "
+                f"{scene.name!r} of size {width:.2f} x {depth:.2f} m: the maximum must be "
+                f"at most {reach:.2f} m")
+
     def sample_episode(self, scene: Scene, rng: np.random.Generator,
                        max_tries: int = 200) -> Episode:
         for _ in range(max_tries):

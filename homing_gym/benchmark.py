@@ -1,0 +1,119 @@
+"""Speed benchmark: env steps per second against render-only panoramas per second.
+
+``python -m homing_gym.benchmark`` (or ``homing-benchmark``) measures, for each
+configuration, in the same run:
+
+* ``render``: panoramas per second of the camera alone at random poses in the same world
+  (the reference: what the env cannot avoid doing);
+* ``env``: ``env.step`` calls per second with random actions in one process (resets
+  included when episodes end);
+* ``vector``: env steps per second summed over a ``gymnasium.vector.AsyncVectorEnv`` of
+  ``--workers`` processes;
+* ``ratio``: time per env step divided by time per render (1.25 = the env adds 25%).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from dataclasses import asdict, dataclass
+
+import gymnasium as gym
+import numpy as np
+from tqdm import tqdm
+
+import homing_gym  # noqa: F401  (registers the envs)
+
+CONFIGS = {
+    "default": {},
+    "W=360": {"panorama_shape": (60, 360)},
+}
+
+
+@dataclass
+class BenchmarkResult:
+    """Throughputs (per second) of one configuration."""
+
+    config: str
+    env_kwargs: dict
+    render_per_s: float
+    env_steps_per_s: float
+    vector_steps_per_s: float
+    workers: int
+
+    @property
+    def ratio(self) -> float:
+        """Time per env step over time per render."""
+        return self.render_per_s / self.env_steps_per_s
+
+
+def render_rate(env: gym.Env, n: int, rng: np.random.Generator, desc: str) -> float:
+    """Panoramas per second rendered at random free poses of the env's world."""
+    u = env.unwrapped
+    (xmin, ymin), (xmax, ymax) = u.scene.bounds
+    poses = np.column_stack([rng.uniform(xmin, xmax, n), rng.uniform(ymin, ymax, n),
+                             rng.uniform(-np.pi, np.pi, n)])
+    start = time.perf_counter()
+    for pose in tqdm(poses, desc=desc, leave=False):
+        u.render_panorama(pose)
+    return n / (time.perf_counter() - start)
+
+
+def step_rate(env, n: int, desc: str, batch: int = 1) -> float:
+    """Env steps per second with random actions (``batch`` envs per call for vector envs)."""
+    env.action_space.seed(0)
+    env.reset(seed=0)
+    start = time.perf_counter()
+    for _ in tqdm(range(n), desc=desc, leave=False):
+        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        if batch == 1 and (terminated or truncated):
+            env.reset()
+    return n * batch / (time.perf_counter() - start)
+
+
+def run_config(name: str, env_kwargs: dict, steps: int, workers: int,
+               env_id: str = "homing_gym/LocalHoming-v0") -> BenchmarkResult:
+    """Measure one configuration: render-only, single env and vector env."""
+    env = gym.make(env_id, **env_kwargs)
+    env.reset(seed=0)
+    rng = np.random.default_rng(0)
+    render_rate(env, 20, rng, "warm-up")
+    render = render_rate(env, steps, rng, f"{name}: render")
+    single = step_rate(env, steps, f"{name}: env")
+    env.close()
+    vec = gym.make_vec(env_id, num_envs=workers, vectorization_mode="async",
+                       vector_kwargs={"context": "spawn"}, **env_kwargs)
+    vector = step_rate(vec, steps // workers, f"{name}: vector x{workers}", batch=workers)
+    vec.close()
+    return BenchmarkResult(name, env_kwargs, render, single, vector, workers)
+
+
+def format_table(results: list[BenchmarkResult]) -> str:
+    """A Markdown table of the results."""
+    lines = ["| config | render (pano/s) | env (steps/s) | env / render time | "
+             "AsyncVectorEnv (steps/s) |", "|---|---|---|---|---|"]
+    for r in results:
+        lines.append(f"| {r.config} | {r.render_per_s:.1f} | {r.env_steps_per_s:.1f} | "
+                     f"{r.ratio:.3f} | {r.vector_steps_per_s:.1f} ({r.workers} workers) |")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--steps", type=int, default=500, help="steps per measurement")
+    parser.add_argument("--workers", type=int, default=2, help="AsyncVectorEnv workers")
+    parser.add_argument("--json", help="also write the results to this JSON file")
+    args = parser.parse_args(argv)
+    if args.steps < 10 or args.workers < 1:
+        parser.error("need --steps >= 10 and --workers >= 1")
+    results = [run_config(name, kwargs, args.steps, args.workers)
+               for name, kwargs in CONFIGS.items()]
+    print(format_table(results))
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump([asdict(r) | {"ratio": r.ratio} for r in results], f, indent=2)
+
+
+if __name__ == "__main__":
+    main()
