@@ -22,7 +22,9 @@ class LocalHomingEnv(HomingEnv):
     ``Box(-1, 1, (2,), float32)``: (forward speed, yaw rate), scaled by ``max_speed``
     (0.3 m/s) and ``max_yaw_rate`` (1.5 rad/s, counter-clockwise positive) and turned into
     wheel speeds by the unicycle model. Finite values outside ``[-1, 1]`` are clipped; NaN
-    or infinite values raise ``ValueError``. With ``action_type="discrete"``: ``Discrete(4)``,
+    or infinite values raise ``ValueError``. The wheel motors ramp towards the commanded
+    speeds at up to 2 m/s^2 of rim acceleration (``RobotConfig.wheel_acceleration``), so
+    full speed is reached within about 0.15 s. With ``action_type="discrete"``: ``Discrete(4)``,
     0 forward at full speed, 1 turn left, 2 turn right, 3 stop. Each action is held for one
     control period of ``control_period`` = 0.1 s, simulated in ``physics_substeps`` = 24
     physics steps of 1/240 s.
