@@ -48,45 +48,53 @@ class BenchmarkResult:
         return self.render_per_s / self.env_steps_per_s
 
 
-def render_rate(env: gym.Env, n: int, rng: np.random.Generator, desc: str) -> float:
-    """Panoramas per second rendered at random free poses of the env's world."""
+def render_rate(env: gym.Env, n: int, rng: np.random.Generator) -> float:
+    """Panoramas per second rendered at random poses of the env's world."""
     u = env.unwrapped
     (xmin, ymin), (xmax, ymax) = u.scene.bounds
     poses = np.column_stack([rng.uniform(xmin, xmax, n), rng.uniform(ymin, ymax, n),
                              rng.uniform(-np.pi, np.pi, n)])
     start = time.perf_counter()
-    for pose in tqdm(poses, desc=desc, leave=False):
+    for pose in poses:
         u.render_panorama(pose)
     return n / (time.perf_counter() - start)
 
 
-def step_rate(env, n: int, desc: str, batch: int = 1) -> float:
+def step_rate(env, n: int, batch: int = 1) -> float:
     """Env steps per second with random actions (``batch`` envs per call for vector envs)."""
-    env.action_space.seed(0)
-    env.reset(seed=0)
     start = time.perf_counter()
-    for _ in tqdm(range(n), desc=desc, leave=False):
+    for _ in range(n):
         _, _, terminated, truncated, _ = env.step(env.action_space.sample())
         if batch == 1 and (terminated or truncated):
             env.reset()
     return n * batch / (time.perf_counter() - start)
 
 
-def run_config(name: str, env_kwargs: dict, steps: int, workers: int,
+def run_config(name: str, env_kwargs: dict, steps: int, workers: int, rounds: int = 10,
                env_id: str = "homing_gym/LocalHoming-v0") -> BenchmarkResult:
-    """Measure one configuration: render-only, single env and vector env."""
+    """Measure one configuration. Render-only and env blocks alternate over ``rounds``
+    rounds and the medians are reported, so that load from other processes hits both
+    alike; the vector env is measured after them."""
     env = gym.make(env_id, **env_kwargs)
+    env.action_space.seed(0)
     env.reset(seed=0)
     rng = np.random.default_rng(0)
-    render_rate(env, 20, rng, "warm-up")
-    render = render_rate(env, steps, rng, f"{name}: render")
-    single = step_rate(env, steps, f"{name}: env")
+    render_rate(env, 20, rng)
+    block = max(steps // rounds, 5)
+    renders, singles = [], []
+    for _ in tqdm(range(rounds), desc=f"{name}: render and env"):
+        renders.append(render_rate(env, block, rng))
+        singles.append(step_rate(env, block))
     env.close()
     vec = gym.make_vec(env_id, num_envs=workers, vectorization_mode="async",
                        vector_kwargs={"context": "spawn"}, **env_kwargs)
-    vector = step_rate(vec, steps // workers, f"{name}: vector x{workers}", batch=workers)
+    vec.action_space.seed(0)
+    vec.reset(seed=0)
+    vector = np.median([step_rate(vec, max(block // workers, 5), batch=workers)
+                        for _ in tqdm(range(rounds), desc=f"{name}: vector x{workers}")])
     vec.close()
-    return BenchmarkResult(name, env_kwargs, render, single, vector, workers)
+    return BenchmarkResult(name, env_kwargs, float(np.median(renders)),
+                           float(np.median(singles)), float(vector), workers)
 
 
 def format_table(results: list[BenchmarkResult]) -> str:

@@ -65,7 +65,6 @@ class Robot:
         }
         self.wheel_joints = [names["left_wheel_joint"], names["right_wheel_joint"]]
         self.caster_link = names["caster_joint"]
-        self.camera_link = names["camera_joint"]
         for j in self.wheel_joints:
             client.changeDynamics(self.body_id, j, lateralFriction=1.0, spinningFriction=0.0,
                                   rollingFriction=0.0)
@@ -76,6 +75,10 @@ class Robot:
         info = client.getDynamicsInfo(self.body_id, -1)
         self._com_in_link = (info[3], info[4])
         self._link_in_com = client.invertTransform(*self._com_in_link)
+        self._target = [0.0, 0.0]
+        self._current = [0.0, 0.0]
+        self._forces = [config.wheel_torque] * 2
+        self._set_motors = client.setJointMotorControlArray
 
     def set_pose(self, x: float, y: float, yaw: float) -> None:
         """Teleport the robot to a pose on the floor, at rest."""
@@ -86,7 +89,7 @@ class Robot:
         self.client.resetBaseVelocity(self.body_id, [0, 0, 0], [0, 0, 0])
         for j in self.wheel_joints:
             self.client.resetJointState(self.body_id, j, 0.0, 0.0)
-        self._current = np.zeros(2)
+        self._current = [0.0, 0.0]
         self.drive(0.0, 0.0)
         self.update_motors(0.0)
         # Refresh the contact cache at the new pose: without this, contacts remembered from
@@ -96,15 +99,18 @@ class Robot:
     def drive(self, v: float, w: float) -> None:
         """Command forward speed ``v`` (m/s) and yaw rate ``w`` (rad/s); the wheel motors
         ramp towards it in :meth:`update_motors`."""
-        self._target = np.array(wheel_speeds(v, w, self.config))
+        self._target = list(wheel_speeds(v, w, self.config))
 
     def update_motors(self, dt: float) -> None:
-        """Move the wheel motor targets towards the command by one ramp step of ``dt`` s."""
+        """Move the wheel motor targets towards the command by one ramp step of ``dt`` s
+        (called before every physics step; plain floats, as it runs 240 times a second)."""
+        if self._current == self._target and dt > 0:
+            return
         limit = self.config.wheel_acceleration / self.config.wheel_radius * dt
-        self._current = self._current + np.clip(self._target - self._current, -limit, limit)
-        self.client.setJointMotorControlArray(
-            self.body_id, self.wheel_joints, p.VELOCITY_CONTROL,
-            targetVelocities=self._current.tolist(), forces=[self.config.wheel_torque] * 2)
+        self._current = [c + max(-limit, min(limit, t - c))
+                         for c, t in zip(self._current, self._target)]
+        self._set_motors(self.body_id, self.wheel_joints, p.VELOCITY_CONTROL,
+                         targetVelocities=self._current, forces=self._forces)
 
     def pose(self) -> np.ndarray:
         """True pose ``(x, y, yaw)`` of the body centre on the floor (float64)."""

@@ -38,6 +38,8 @@ class Simulator:
         if gui:
             c.configureDebugVisualizer(p.COV_ENABLE_GUI, 0)
         self.time_step = time_step
+        self._step_simulation = c.stepSimulation      # BulletClient builds a new partial on
+        self._contact_points = c.getContactPoints     # every attribute access: keep these
         self._textures: dict[str, int] = {}
         self.scene = scene
         self.floor_id = self._make_floor(scene)
@@ -132,15 +134,16 @@ class Simulator:
     def step(self, substeps: int) -> bool:
         """Advance the physics ``substeps`` times; True if the robot touched an obstacle."""
         touched = False
+        step, update_motors = self._step_simulation, self.robot.update_motors
         for _ in range(substeps):
-            self.robot.update_motors(self.time_step)
-            self.client.stepSimulation()
+            update_motors(self.time_step)
+            step()
             touched = touched or self.robot_in_contact()
         return touched
 
     def robot_in_contact(self) -> bool:
         """True if the robot currently touches a wall or landmark (the floor does not count)."""
-        contacts = self.client.getContactPoints(bodyA=self.robot.body_id)
+        contacts = self._contact_points(bodyA=self.robot.body_id)
         return any(cp[2] in self.obstacle_ids for cp in contacts)
 
     def close(self) -> None:
