@@ -10,13 +10,10 @@ subclasses in :mod:`homing_gym.envs` that choose the task and carry the env card
 from __future__ import annotations
 
 import math
-import pkgutil
-import warnings
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
-import pybullet as p
 from gymnasium import spaces
 
 from homing_gym.geometry import to_frame
@@ -86,18 +83,18 @@ class HomingEnv(gym.Env):
         self.stop_threshold = float(stop_threshold)
         self.robot_config = RobotConfig(max_speed=float(max_speed),
                                         max_yaw_rate=float(max_yaw_rate))
-        self.camera = PanoramaCamera(
-            CameraConfig(panorama_shape=tuple(panorama_shape), vfov=math.radians(vfov_deg),
-                         n_views=n_views, omni_size=omni_size, renderer=renderer),
-            camera_height=self.robot_config.camera_height)
+        camera_config = CameraConfig(
+            panorama_shape=tuple(panorama_shape), vfov=math.radians(vfov_deg),
+            n_views=n_views, omni_size=omni_size, renderer=renderer)
         self.odometry = WheelOdometry(self.robot_config, odometry_noise)
         self._scene_factory = scene_factory(scene)
         self.scene = self._scene_factory.build(np.random.default_rng(0))
         task.check_scene(self.scene)
         self.sim = Simulator(self.scene, gui=render_mode == "human",
                              time_step=self.control_period / self.physics_substeps,
-                             robot_config=self.robot_config)
-        self._renderer = self._renderer_id(renderer)
+                             robot_config=self.robot_config, renderer=renderer)
+        self.camera = PanoramaCamera(camera_config, self.robot_config.camera_height,
+                                     renderer=self.sim.renderer)
 
         H, W = self.camera.config.panorama_shape
         S = self.camera.config.omni_size
@@ -122,23 +119,10 @@ class HomingEnv(gym.Env):
         self._goal_obs: dict[str, np.ndarray] = {}
 
     # -- helpers --------------------------------------------------------------------------
-    def _renderer_id(self, renderer: str) -> int:
-        if renderer == "tiny":
-            return p.ER_TINY_RENDERER
-        egl = pkgutil.get_loader("eglRenderer")
-        plugin = -1
-        if egl is not None:
-            plugin = self.sim.client.loadPlugin(egl.get_filename(), "_eglRendererPlugin")
-        if plugin < 0:
-            warnings.warn("renderer='egl' requested but the EGL plugin could not be loaded; "
-                          "falling back to TinyRenderer", RuntimeWarning, stacklevel=3)
-            return p.ER_TINY_RENDERER
-        return p.ER_BULLET_HARDWARE_OPENGL
-
     def render_panorama(self, pose) -> np.ndarray:
         """Panorama (uint8 HWC) the robot's camera would see at ``pose`` in the current
         world, rendered as is (the robot body stays where it is)."""
-        return self.camera.render(self.sim.client, pose, self._renderer)
+        return self.camera.render(self.sim.client, pose)
 
     @property
     def distance_to_goal(self) -> float:

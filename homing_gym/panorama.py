@@ -23,7 +23,9 @@ Conventions (tested in ``tests/test_panorama.py``):
 
 The panorama is rendered by PyBullet from ``n_views`` perspective cameras at the camera
 centre, facing evenly spaced yaws, and resampled into the cylinder with a single
-precomputed ``cv2.remap``.
+precomputed ``cv2.remap``. TinyRenderer (CPU, default) and EGL (GPU) give the same
+geometry; their shading and background colour differ, so do not mix them between
+training and evaluation.
 """
 
 from __future__ import annotations
@@ -125,8 +127,14 @@ def view_geometry(config: CameraConfig) -> ViewGeometry:
     return ViewGeometry(width=width, height=height, focal=focal, yaws=yaws)
 
 
-def panorama_maps(config: CameraConfig, geom: ViewGeometry) -> tuple[np.ndarray, np.ndarray]:
-    """``cv2.remap`` maps from the side-by-side views ``(h, n*w)`` to the panorama ``(H, W)``."""
+def panorama_maps(config: CameraConfig, geom: ViewGeometry,
+                  pixel_centre: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """``cv2.remap`` maps from the side-by-side views ``(h, n*w)`` to the panorama ``(H, W)``.
+
+    ``pixel_centre`` is where the renderer samples pixel ``i``: at image coordinate
+    ``i + pixel_centre``. TinyRenderer samples at ``i`` (0.0), OpenGL (EGL) at ``i + 0.5``;
+    both measured with the pole test of ``tests/test_panorama.py``.
+    """
     H, W = config.panorama_shape
     beta = column_bearing(np.arange(W) + 0.5, W)[None, :].repeat(H, 0)
     elev = row_elevation(np.arange(H) + 0.5, H, config.vfov)[:, None].repeat(W, 1)
@@ -137,10 +145,8 @@ def panorama_maps(config: CameraConfig, geom: ViewGeometry) -> tuple[np.ndarray,
     fwd = np.cos(elev) * np.cos(rel)
     left = np.cos(elev) * np.sin(rel)
     up = np.sin(elev)
-    # PyBullet's renderer samples pixel i at image coordinate i (no half-pixel offset,
-    # measured with the pole test), so these are directly the remap coordinates.
-    u = geom.width / 2 - geom.focal * left / fwd
-    v = geom.height / 2 - geom.focal * up / fwd
+    u = geom.width / 2 - geom.focal * left / fwd - pixel_centre
+    v = geom.height / 2 - geom.focal * up / fwd - pixel_centre
     map_x = (u + view * geom.width).astype(np.float32)
     map_y = v.astype(np.float32)
     return map_x, map_y
@@ -184,11 +190,14 @@ def signature_weights(height: int, rows: int) -> np.ndarray:
 class PanoramaCamera:
     """Renders panoramas at a robot pose and derives the ``omni`` and ``signature`` views."""
 
-    def __init__(self, config: CameraConfig = CameraConfig(), camera_height: float = 0.30):
+    def __init__(self, config: CameraConfig = CameraConfig(), camera_height: float = 0.30,
+                 renderer: int = p.ER_TINY_RENDERER):
         self.config = config
         self.camera_height = camera_height
+        self.renderer = renderer
         self.geometry = view_geometry(config)
-        self._map_x, self._map_y = panorama_maps(config, self.geometry)
+        centre = 0.5 if renderer == p.ER_BULLET_HARDWARE_OPENGL else 0.0
+        self._map_x, self._map_y = panorama_maps(config, self.geometry, centre)
         self._omni_x, self._omni_y, self._omni_mask = omni_maps(config)
         self._sig_weights = signature_weights(config.panorama_shape[0], config.signature_rows)
         g = self.geometry
@@ -201,7 +210,7 @@ class PanoramaCamera:
     def shape(self) -> tuple[int, int, int]:
         return (*self.config.panorama_shape, 3)
 
-    def render_views(self, client: BulletClient, pose, renderer: int) -> np.ndarray:
+    def render_views(self, client: BulletClient, pose) -> np.ndarray:
         """The ``n_views`` perspective images side by side, uint8 ``(h, n*w, 3)``."""
         g = self.geometry
         x, y, yaw = float(pose[0]), float(pose[1]), float(pose[2])
@@ -211,7 +220,7 @@ class PanoramaCamera:
             target = [x + math.cos(a), y + math.sin(a), self.camera_height]
             view = client.computeViewMatrix(eye, target, [0, 0, 1])
             _, _, rgba, _, _ = client.getCameraImage(
-                g.width, g.height, view, self._projection, renderer=renderer,
+                g.width, g.height, view, self._projection, renderer=self.renderer,
                 shadow=0, lightDirection=[0.4, 0.3, 1.0], lightAmbientCoeff=0.6,
                 lightDiffuseCoeff=0.45, lightSpecularCoeff=0.05,
                 flags=p.ER_NO_SEGMENTATION_MASK)
@@ -219,9 +228,9 @@ class PanoramaCamera:
             self._views[:, k * g.width:(k + 1) * g.width] = rgba[..., :3]
         return self._views
 
-    def render(self, client: BulletClient, pose, renderer: int) -> np.ndarray:
+    def render(self, client: BulletClient, pose) -> np.ndarray:
         """Panorama at ``pose = (x, y, yaw)`` (metres, radians): uint8 ``(H, W, 3)``."""
-        views = self.render_views(client, pose, renderer)
+        views = self.render_views(client, pose)
         return cv2.remap(views, self._map_x, self._map_y, cv2.INTER_LINEAR,
                          borderMode=cv2.BORDER_REPLICATE)
 

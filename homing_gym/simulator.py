@@ -12,7 +12,12 @@ Physics: ``time_step`` (default 1/240 s) per ``stepSimulation``; the env runs
 
 from __future__ import annotations
 
+import functools
 import math
+import os
+import pkgutil
+import tempfile
+import warnings
 
 import pybullet as p
 from pybullet_utils.bullet_client import BulletClient
@@ -28,10 +33,12 @@ class Simulator:
     """One PyBullet client holding a scene and the robot."""
 
     def __init__(self, scene: Scene, *, gui: bool = False, time_step: float = 1 / 240,
-                 robot_config: RobotConfig = RobotConfig()):
+                 robot_config: RobotConfig = RobotConfig(), renderer: str = "tiny"):
         self.client = BulletClient(connection_mode=p.GUI if gui else p.DIRECT)
         self._connected = True
         c = self.client
+        # the EGL plugin only sees bodies created after it is loaded: load it first
+        self.renderer = load_egl(c) if renderer == "egl" else p.ER_TINY_RENDERER
         c.setGravity(0, 0, -9.81)
         c.setTimeStep(time_step)
         c.setPhysicsEngineParameter(deterministicOverlappingPairs=1, numSolverIterations=10)
@@ -155,3 +162,50 @@ class Simulator:
     @property
     def connected(self) -> bool:
         return self._connected
+
+
+SOFTWARE_GL = ("llvmpipe", "softpipe", "swrast")
+
+
+@functools.cache
+def egl_status() -> str | None:
+    """Why EGL cannot be used in this process, or ``None`` if it can. Probed once, in a
+    throwaway client: the plugin prints the OpenGL renderer's name to fd 1, and a
+    software rasteriser (Mesa llvmpipe: no GPU, slower than TinyRenderer) does not count.
+    (Unloading the plugin from a client that keeps running crashes PyBullet, hence the
+    separate client.)"""
+    egl = pkgutil.get_loader("eglRenderer")
+    if egl is None:
+        return "PyBullet has no eglRenderer plugin"
+    probe = BulletClient(connection_mode=p.DIRECT)
+    with tempfile.TemporaryFile(mode="w+") as log:
+        saved = os.dup(1)
+        os.dup2(log.fileno(), 1)
+        try:
+            plugin = probe.loadPlugin(egl.get_filename(), "_eglRendererPlugin")
+        finally:
+            os.dup2(saved, 1)
+            os.close(saved)
+            probe.disconnect()
+        log.seek(0)
+        gl_info = log.read()
+    if plugin < 0:
+        return "the EGL plugin could not be loaded"
+    if any(name in gl_info for name in SOFTWARE_GL):
+        return "EGL runs on a software rasteriser (no GPU)"
+    return None
+
+
+def load_egl(client: BulletClient) -> int:
+    """Load PyBullet's EGL renderer plugin into ``client`` and return the renderer flag
+    for ``getCameraImage``; fall back to TinyRenderer with a ``RuntimeWarning`` where
+    :func:`egl_status` says EGL cannot be used."""
+    reason = egl_status()
+    if reason is None and client.loadPlugin(pkgutil.get_loader("eglRenderer").get_filename(),
+                                            "_eglRendererPlugin") < 0:
+        reason = "the EGL plugin could not be loaded"
+    if reason:
+        warnings.warn(f"renderer='egl' requested but {reason}; falling back to TinyRenderer",
+                      RuntimeWarning, stacklevel=3)
+        return p.ER_TINY_RENDERER
+    return p.ER_BULLET_HARDWARE_OPENGL
