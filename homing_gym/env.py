@@ -165,6 +165,23 @@ class HomingEnv(gym.Env):
                     if k in self.obs_keys})
         return obs
 
+    def _episode_with_options(self, episode: Episode, options: dict) -> Episode:
+        """Apply ``reset(options={"home": pose, "start": pose})`` overrides (poses
+        ``(x, y, yaw)`` in metres and radians, inside the scene bounds)."""
+        unknown = sorted(set(options) - {"home", "start"})
+        if unknown:
+            raise ValueError(f"unknown reset options {unknown}; allowed: ['home', 'start']")
+        poses = {"home": episode.home, "start": episode.start}
+        (xmin, ymin), (xmax, ymax) = self.scene.bounds
+        for key, value in options.items():
+            pose = np.asarray(value, dtype=np.float64)
+            if pose.shape != (3,) or not np.all(np.isfinite(pose)) or not (
+                    xmin <= pose[0] <= xmax and ymin <= pose[1] <= ymax):
+                raise ValueError(f"reset option {key}={value!r} must be a finite pose "
+                                 f"(x, y, yaw) with x in [{xmin}, {xmax}], y in [{ymin}, {ymax}]")
+            poses[key] = pose
+        return Episode(home=poses["home"], start=poses["start"])
+
     def _info(self, collision: bool = False, success: bool = False,
               rewards: dict[str, float] | None = None) -> dict[str, Any]:
         return {
@@ -183,7 +200,8 @@ class HomingEnv(gym.Env):
         if self._scene_factory.randomised:
             self.scene = self._scene_factory.build(self.np_random)
         self.sim.reset_world(self.scene)
-        self.episode = self.task.sample_episode(self.scene, self.np_random)
+        self.episode = self._episode_with_options(
+            self.task.sample_episode(self.scene, self.np_random), options or {})
         robot = self.sim.robot
         robot.set_pose(*self.episode.home)
         goal = self.render_panorama(self.episode.home)

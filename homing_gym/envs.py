@@ -61,6 +61,8 @@ class LocalHomingEnv(HomingEnv):
     landmarks. Start: at a distance drawn uniformly from ``start_distance`` = (0.3, 1.5) m
     in a random direction from home, also collision-free, with a uniform random heading.
     Everything is drawn from the generator seeded by ``reset(seed=...)``.
+    ``reset(options={"home": (x, y, yaw), "start": (x, y, yaw)})`` sets either pose
+    instead (metres, radians; e.g. to place the robot on a grid for a homing vector field).
 
     ## Episode end
 

@@ -119,3 +119,15 @@ def test_async_vector_env_two_workers():
         obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
     assert reward.shape == (2,)
     env.close()
+
+
+def test_reset_options_place_home_and_start(make_env):
+    env = make_env()
+    obs, info = env.reset(seed=0, options={"home": (0.0, 0.0, 0.5), "start": (0.8, -0.3, 2.0)})
+    assert np.allclose(info["goal_pose"], (0.0, 0.0, 0.5))
+    assert np.allclose(info["pose"], (0.8, -0.3, 2.0), atol=1e-6)
+    assert info["distance_to_goal"] == pytest.approx(np.hypot(0.8, 0.3))
+    with pytest.raises(ValueError, match="start"):
+        env.reset(seed=0, options={"start": (5.0, 0.0, 0.0)})
+    with pytest.raises(ValueError, match="teleport"):
+        env.reset(seed=0, options={"teleport": True})
