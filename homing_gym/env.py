@@ -17,7 +17,7 @@ import numpy as np
 from gymnasium import spaces
 
 from homing_gym.geometry import to_frame
-from homing_gym.panorama import CameraConfig, PanoramaCamera
+from homing_gym.panorama import CameraConfig, Lighting, PanoramaCamera, random_lighting
 from homing_gym.robot import RobotConfig, WheelOdometry
 from homing_gym.scenes import scene_factory
 from homing_gym.scenes.base import Scene
@@ -53,7 +53,7 @@ class HomingEnv(gym.Env):
                  action_type: str = "continuous", control_period: float = 0.1,
                  physics_substeps: int = 24, max_speed: float = RobotConfig.max_speed,
                  max_yaw_rate: float = RobotConfig.max_yaw_rate, stop_threshold: float = 0.05,
-                 odometry_noise: float = 0.02):
+                 odometry_noise: float = 0.02, lighting_change: float = 0.0):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"unknown render_mode {render_mode!r}; allowed: "
                              f"{self.metadata['render_modes']} or None")
@@ -66,6 +66,8 @@ class HomingEnv(gym.Env):
         for name, value in (("max_speed", max_speed), ("max_yaw_rate", max_yaw_rate)):
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"{name} must be a positive number, got {value!r}")
+        if not (0 <= lighting_change <= 1):
+            raise ValueError(f"lighting_change must be in [0, 1] (0: off), got {lighting_change!r}")
         if not (0 <= stop_threshold < 1):
             raise ValueError(f"stop_threshold must be in [0, 1), got {stop_threshold!r}")
         task_keys = task.extra_spaces()
@@ -81,6 +83,8 @@ class HomingEnv(gym.Env):
         self.control_period = float(control_period)
         self.physics_substeps = int(physics_substeps)
         self.stop_threshold = float(stop_threshold)
+        self.lighting_change = float(lighting_change)
+        self._lighting: Lighting | None = None
         self.robot_config = RobotConfig(max_speed=float(max_speed),
                                         max_yaw_rate=float(max_yaw_rate))
         camera_config = CameraConfig(
@@ -116,19 +120,45 @@ class HomingEnv(gym.Env):
         self.trajectory: list[tuple[float, float]] = []
         self.collisions = 0
         self._panorama = np.zeros((H, W, 3), np.uint8)
+        self.goal_index = 0
+        self._goal_views: list[dict[str, np.ndarray]] = []
         self._goal_obs: dict[str, np.ndarray] = {}
 
     # -- helpers --------------------------------------------------------------------------
     def render_panorama(self, pose) -> np.ndarray:
         """Panorama (uint8 HWC) the robot's camera would see at ``pose`` in the current
-        world, rendered as is (the robot body stays where it is)."""
-        return self.camera.render(self.sim.client, pose)
+        world and the episode's lighting, rendered as is (the robot body stays where it is)."""
+        return self.camera.render(self.sim.client, pose, self._lighting)
+
+    @property
+    def goal_pose(self) -> np.ndarray:
+        """The pose of the current goal (home, or the current waypoint of a route)."""
+        return self.episode.goals[self.goal_index]
 
     @property
     def distance_to_goal(self) -> float:
-        """Distance (metres) between the robot centre and the home position."""
-        return float(math.hypot(self.pose[0] - self.episode.home[0],
-                                self.pose[1] - self.episode.home[1]))
+        """Distance (metres) between the robot centre and the current goal position."""
+        goal = self.goal_pose
+        return float(math.hypot(self.pose[0] - goal[0], self.pose[1] - goal[1]))
+
+    def advance_goal(self) -> None:
+        """Make the next goal of the episode current (tasks with routes call this)."""
+        if self.goal_index + 1 >= len(self.episode.goals):
+            raise RuntimeError("the episode has no further goal")
+        self.goal_index += 1
+        self._goal_obs = self._goal_views[self.goal_index]
+
+    def _snapshot(self, pose: np.ndarray) -> dict[str, np.ndarray]:
+        """Goal observations of a snapshot taken with the robot standing at ``pose``
+        (rendered with the scene's snapshot-time lighting)."""
+        self.sim.robot.set_pose(*pose)
+        goal = self.camera.render(self.sim.client, pose)
+        views = {"goal": goal}
+        if "goal_omni" in self.obs_keys:
+            views["goal_omni"] = self.camera.omni(goal)
+        if "goal_signature" in self.obs_keys:
+            views["goal_signature"] = self.camera.signature(goal)
+        return views
 
     def _command(self, action) -> tuple[float, float, bool]:
         """Validated action -> (forward, yaw) in normalised units and the stop flag."""
@@ -180,18 +210,19 @@ class HomingEnv(gym.Env):
                 raise ValueError(f"reset option {key}={value!r} must be a finite pose "
                                  f"(x, y, yaw) with x in [{xmin}, {xmax}], y in [{ymin}, {ymax}]")
             poses[key] = pose
-        return Episode(home=poses["home"], start=poses["start"])
+        return Episode(home=poses["home"], start=poses["start"], waypoints=episode.waypoints)
 
     def _info(self, collision: bool = False, success: bool = False,
               rewards: dict[str, float] | None = None) -> dict[str, Any]:
         return {
             "pose": self.pose.copy(),
-            "goal_pose": self.episode.home.copy(),
+            "goal_pose": self.goal_pose.copy(),
             "distance_to_goal": self.distance_to_goal,
             "is_success": bool(success),
             "collision": bool(collision),
             "collisions": self.collisions,
             "rewards": rewards or {},
+            **self.task.extra_info(self),
         }
 
     # -- Gymnasium API --------------------------------------------------------------------
@@ -202,14 +233,12 @@ class HomingEnv(gym.Env):
         self.sim.reset_world(self.scene)
         self.episode = self._episode_with_options(
             self.task.sample_episode(self.scene, self.np_random), options or {})
+        self._goal_views = [self._snapshot(goal) for goal in self.episode.goals]
+        self.goal_index = 0
+        self._goal_obs = self._goal_views[0]
+        self._lighting = (random_lighting(self.np_random, self.lighting_change)
+                          if self.lighting_change > 0 else None)
         robot = self.sim.robot
-        robot.set_pose(*self.episode.home)
-        goal = self.render_panorama(self.episode.home)
-        self._goal_obs = {"goal": goal}
-        if "goal_omni" in self.obs_keys:
-            self._goal_obs["goal_omni"] = self.camera.omni(goal)
-        if "goal_signature" in self.obs_keys:
-            self._goal_obs["goal_signature"] = self.camera.signature(goal)
         robot.set_pose(*self.episode.start)
         self.pose = robot.pose()
         self.odometry.reset(to_frame(self.episode.home, self.pose), robot.wheel_angles())
@@ -252,9 +281,10 @@ class HomingEnv(gym.Env):
         """The ``rgb_array`` picture: top-down map beside current and goal panoramas."""
         if self.episode is None:
             raise RuntimeError("call reset() before render()")
-        top = draw_topdown(self.scene, self.pose, self.episode.home, self.trajectory,
+        top = draw_topdown(self.scene, self.pose, self.goal_pose, self.trajectory,
                            robot_radius=self.robot_config.body_radius,
-                           success_radius=getattr(self.task, "success_radius", None))
+                           success_radius=getattr(self.task, "success_radius", None),
+                           waypoints=self.episode.goals)
         caption = f"(d = {self.distance_to_goal:.2f} m)"
         return compose_frame(top, self._panorama, self._goal_obs["goal"], caption)
 

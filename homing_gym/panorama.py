@@ -101,6 +101,38 @@ class CameraConfig:
 
 
 @dataclass(frozen=True)
+class Lighting:
+    """Scene lighting of a render: ``direction`` towards the light (world frame), the
+    renderer's ambient/diffuse/specular coefficients, and a global photometric change
+    applied to the picture, ``out = contrast*(in - 127.5) + 127.5 + brightness``."""
+
+    direction: tuple[float, float, float] = (0.4, 0.3, 1.0)
+    ambient: float = 0.6
+    diffuse: float = 0.45
+    specular: float = 0.05
+    brightness: float = 0.0
+    contrast: float = 1.0
+
+
+def random_lighting(rng: np.random.Generator, strength: float) -> Lighting:
+    """A changed lighting drawn from ``rng``: light azimuth anywhere, elevation 20-80
+    degrees, brightness within +-60*strength grey levels, contrast within
+    1 +- 0.4*strength, diffuse/ambient balance shifted by up to 0.2*strength."""
+    azimuth = rng.uniform(-np.pi, np.pi)
+    elevation = rng.uniform(np.radians(20), np.radians(80))
+    shift = rng.uniform(-0.2, 0.2) * strength
+    return Lighting(
+        direction=(math.cos(elevation) * math.cos(azimuth),
+                   math.cos(elevation) * math.sin(azimuth), math.sin(elevation)),
+        ambient=0.6 - shift, diffuse=0.45 + shift,
+        brightness=float(rng.uniform(-60, 60) * strength),
+        contrast=float(1 + rng.uniform(-0.4, 0.4) * strength))
+
+
+DEFAULT_LIGHTING = Lighting()
+
+
+@dataclass(frozen=True)
 class ViewGeometry:
     """Size and intrinsics of the perspective views the panorama is resampled from."""
 
@@ -210,7 +242,8 @@ class PanoramaCamera:
     def shape(self) -> tuple[int, int, int]:
         return (*self.config.panorama_shape, 3)
 
-    def render_views(self, client: BulletClient, pose) -> np.ndarray:
+    def render_views(self, client: BulletClient, pose,
+                     lighting: Lighting = DEFAULT_LIGHTING) -> np.ndarray:
         """The ``n_views`` perspective images side by side, uint8 ``(h, n*w, 3)``."""
         g = self.geometry
         x, y, yaw = float(pose[0]), float(pose[1]), float(pose[2])
@@ -221,18 +254,23 @@ class PanoramaCamera:
             view = client.computeViewMatrix(eye, target, [0, 0, 1])
             _, _, rgba, _, _ = client.getCameraImage(
                 g.width, g.height, view, self._projection, renderer=self.renderer,
-                shadow=0, lightDirection=[0.4, 0.3, 1.0], lightAmbientCoeff=0.6,
-                lightDiffuseCoeff=0.45, lightSpecularCoeff=0.05,
-                flags=p.ER_NO_SEGMENTATION_MASK)
+                shadow=0, lightDirection=list(lighting.direction),
+                lightAmbientCoeff=lighting.ambient, lightDiffuseCoeff=lighting.diffuse,
+                lightSpecularCoeff=lighting.specular, flags=p.ER_NO_SEGMENTATION_MASK)
             rgba = np.asarray(rgba, dtype=np.uint8).reshape(g.height, g.width, 4)
             self._views[:, k * g.width:(k + 1) * g.width] = rgba[..., :3]
         return self._views
 
-    def render(self, client: BulletClient, pose) -> np.ndarray:
-        """Panorama at ``pose = (x, y, yaw)`` (metres, radians): uint8 ``(H, W, 3)``."""
-        views = self.render_views(client, pose)
-        return cv2.remap(views, self._map_x, self._map_y, cv2.INTER_LINEAR,
+    def render(self, client: BulletClient, pose, lighting: Lighting | None = None) -> np.ndarray:
+        """Panorama at ``pose = (x, y, yaw)`` (metres, radians): uint8 ``(H, W, 3)``,
+        under ``lighting`` (``None``: the default lighting)."""
+        views = self.render_views(client, pose, lighting or DEFAULT_LIGHTING)
+        pano = cv2.remap(views, self._map_x, self._map_y, cv2.INTER_LINEAR,
                          borderMode=cv2.BORDER_REPLICATE)
+        if lighting is not None and (lighting.contrast != 1 or lighting.brightness != 0):
+            offset = 127.5 * (1 - lighting.contrast) + lighting.brightness
+            pano = cv2.addWeighted(pano, lighting.contrast, pano, 0.0, offset)
+        return pano
 
     def omni(self, panorama: np.ndarray) -> np.ndarray:
         """The catadioptric ring image of a panorama: uint8 ``(S, S, 3)``."""

@@ -67,11 +67,15 @@ def draw_pose(img: np.ndarray, canvas: MapCanvas, pose, radius: float, color,
 
 
 def draw_topdown(scene: Scene, pose, home, trajectory, robot_radius: float = 0.16,
-                 success_radius: float | None = None, size: int = 360) -> np.ndarray:
-    """Top-down map: scene, home (green, with the success circle), the path so far
-    (orange) and the robot (blue, heading tick). RGB uint8 ``(size, size, 3)``."""
+                 success_radius: float | None = None, size: int = 360,
+                 waypoints=()) -> np.ndarray:
+    """Top-down map: scene, the episode's goals (small green dots), the current goal
+    ``home`` (green, with the success circle), the path so far (orange) and the robot
+    (blue, heading tick). RGB uint8 ``(size, size, 3)``."""
     canvas = MapCanvas(scene, size)
     img = draw_scene(scene, canvas)
+    for waypoint in waypoints:
+        cv2.circle(img, canvas.px(waypoint[0], waypoint[1]), 3, HOME, -1, cv2.LINE_AA)
     if success_radius is not None:
         cv2.circle(img, canvas.px(home[0], home[1]), canvas.length(success_radius), HOME, 1,
                    cv2.LINE_AA)

@@ -22,10 +22,16 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class Episode:
-    """The poses ``(x, y, yaw)`` (metres, radians CCW) of one episode."""
+    """The poses ``(x, y, yaw)`` (metres, radians CCW) of one episode: the start, and the
+    goals to reach in order, ``waypoints`` first and ``home`` last."""
 
     home: np.ndarray
     start: np.ndarray
+    waypoints: tuple[np.ndarray, ...] = ()
+
+    @property
+    def goals(self) -> tuple[np.ndarray, ...]:
+        return (*self.waypoints, self.home)
 
 
 class Task(ABC):
@@ -51,6 +57,10 @@ class Task(ABC):
 
     def extra_observation(self, env: "HomingEnv") -> dict[str, np.ndarray]:
         """Values of the keys of :meth:`extra_spaces` for the current step."""
+        return {}
+
+    def extra_info(self, env: "HomingEnv") -> dict:
+        """Task-specific entries added to ``info`` at reset and every step."""
         return {}
 
 
