@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from homing_gym.env import HomingEnv
 from homing_gym.scenes.base import Scene
-from homing_gym.tasks.local_homing import LocalHomingTask, RewardConfig
+from homing_gym.tasks import LocalHomingTask, RewardConfig
 
 
 class LocalHomingEnv(HomingEnv):

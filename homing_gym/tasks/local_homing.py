@@ -3,40 +3,18 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from homing_gym.scenes.base import Scene, clearance
-from homing_gym.tasks.base import Episode, Task, sample_free_pose
-
-if TYPE_CHECKING:
-    from homing_gym.env import HomingEnv
-
-SUCCESS_MODES = ("reach", "stop")
+from homing_gym.tasks.base import Episode, sample_free_pose
+from homing_gym.tasks.goal_reaching import GoalReachingTask, RewardConfig
 
 
-@dataclass(frozen=True)
-class RewardConfig:
-    """Reward weights. ``progress`` multiplies the decrease of the distance to home (per
-    metre: potential-based shaping with potential ``-distance``); ``success`` is paid once
-    on success; ``collision`` is subtracted on every step with contact; ``time`` on every step."""
-
-    progress: float = 1.0
-    success: float = 10.0
-    collision: float = 0.1
-    time: float = 0.01
-
-
-class LocalHomingTask(Task):
-    """Start within ``start_distance`` metres of a random collision-free home pose.
-
-    ``success_on="reach"`` ends the episode as soon as the robot centre is within
-    ``success_radius`` metres of home. ``success_on="stop"`` ends it when the agent issues
-    the stop action, and counts success only if it stopped within ``success_radius``:
-    the accuracy protocol of the papers, where the method decides it has arrived.
-    """
+class LocalHomingTask(GoalReachingTask):
+    """Start within ``start_distance`` metres of a random collision-free home pose; the
+    only goal is home (see :class:`GoalReachingTask` for ``success_radius`` and
+    ``success_on``)."""
 
     def __init__(self, start_distance: tuple[float, float] = (0.3, 1.5),
                  success_radius: float = 0.15, success_on: str = "reach",
@@ -46,17 +24,9 @@ class LocalHomingTask(Task):
         if not (math.isfinite(lo) and math.isfinite(hi) and 0 <= lo <= hi):
             raise ValueError(f"start_distance must be (min, max) metres with 0 <= min <= max, "
                              f"got {start_distance!r}")
-        if not (math.isfinite(success_radius) and success_radius > 0):
-            raise ValueError(f"success_radius must be a positive number of metres, "
-                             f"got {success_radius!r}")
-        if success_on not in SUCCESS_MODES:
-            raise ValueError(f"unknown success_on {success_on!r}; allowed: {SUCCESS_MODES}")
+        super().__init__(success_radius, success_on, reward)
         self.start_distance = (float(lo), float(hi))
-        self.success_radius = float(success_radius)
-        self.success_on = success_on
-        self.reward = reward
         self.clearance_margin = clearance_margin
-        self._prev_distance = 0.0
 
     def check_scene(self, scene: Scene) -> None:
         width, depth = scene.size
@@ -80,23 +50,3 @@ class LocalHomingTask(Task):
                     return Episode(home=home, start=start)
         raise ValueError(f"start_distance {self.start_distance} m does not fit into scene "
                          f"{scene.name!r} of size {scene.size} m")
-
-    def on_reset(self, env: "HomingEnv") -> None:
-        self._prev_distance = env.distance_to_goal
-
-    def step_outcome(self, env: "HomingEnv", collision: bool, stopped: bool):
-        distance = env.distance_to_goal
-        within = distance < self.success_radius
-        if self.success_on == "stop":
-            terminated = stopped
-            success = stopped and within
-        else:
-            terminated = success = within
-        rewards = {
-            "progress": self.reward.progress * (self._prev_distance - distance),
-            "success": self.reward.success if success else 0.0,
-            "collision": -self.reward.collision if collision else 0.0,
-            "time": -self.reward.time,
-        }
-        self._prev_distance = distance
-        return rewards, terminated, success

@@ -1,0 +1,84 @@
+"""Reaching a sequence of goal poses: the episode logic shared by homing and routes."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from homing_gym.tasks.base import Task
+
+if TYPE_CHECKING:
+    from homing_gym.env import HomingEnv
+
+SUCCESS_MODES = ("reach", "stop")
+
+
+@dataclass(frozen=True)
+class RewardConfig:
+    """Reward weights. ``progress`` multiplies the decrease of the distance to the current
+    goal (per metre: potential-based shaping with potential ``-distance``, restarted when
+    the goal changes); ``waypoint`` is paid for each intermediate goal of a route,
+    ``success`` once on success; ``collision`` is subtracted on every step with contact,
+    ``time`` on every step."""
+
+    progress: float = 1.0
+    waypoint: float = 1.0
+    success: float = 10.0
+    collision: float = 0.1
+    time: float = 0.01
+
+
+class GoalReachingTask(Task):
+    """Visit the episode's goals in order (``Episode.goals``: waypoints, then home).
+
+    ``success_on="reach"``: a goal is reached as soon as the robot centre is within
+    ``success_radius`` metres of it. ``success_on="stop"``: the agent itself signals arrival
+    with the stop action; the goal is then left with the distance at the stop as its error
+    (the accuracy protocol of the papers, where the method decides it has arrived). After
+    the last goal the episode terminates; it is a success if that goal was within
+    ``success_radius``. ``goal_errors`` holds the distance (metres) at which each goal was
+    left.
+    """
+
+    def __init__(self, success_radius: float = 0.15, success_on: str = "reach",
+                 reward: RewardConfig = RewardConfig()):
+        if not (math.isfinite(success_radius) and success_radius > 0):
+            raise ValueError(f"success_radius must be a positive number of metres, "
+                             f"got {success_radius!r}")
+        if success_on not in SUCCESS_MODES:
+            raise ValueError(f"unknown success_on {success_on!r}; allowed: {SUCCESS_MODES}")
+        self.success_radius = float(success_radius)
+        self.success_on = success_on
+        self.reward = reward
+        self.goal_errors: list[float] = []
+        self._prev_distance = 0.0
+
+    def on_reset(self, env: "HomingEnv") -> None:
+        self._prev_distance = env.distance_to_goal
+        self.goal_errors = []
+
+    def step_outcome(self, env: "HomingEnv", collision: bool, stopped: bool):
+        distance = env.distance_to_goal
+        within = distance < self.success_radius
+        arrived = stopped if self.success_on == "stop" else within
+        last = env.goal_index == len(env.episode.goals) - 1
+        rewards = {
+            "progress": self.reward.progress * (self._prev_distance - distance),
+            "waypoint": 0.0,
+            "success": 0.0,
+            "collision": -self.reward.collision if collision else 0.0,
+            "time": -self.reward.time,
+        }
+        self._prev_distance = distance
+        terminated = success = False
+        if arrived:
+            self.goal_errors.append(distance)
+            if last:
+                terminated, success = True, within
+                rewards["success"] = self.reward.success if success else 0.0
+            else:
+                rewards["waypoint"] = self.reward.waypoint if within else 0.0
+                env.advance_goal()
+                self._prev_distance = env.distance_to_goal
+        return rewards, terminated, success
