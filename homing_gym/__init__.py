@@ -14,6 +14,7 @@ __version__ = "0.1.0"
 #: Registered env ids, with their entry points and step limits.
 _ENVS = {
     "homing_gym/LocalHoming-v0": ("homing_gym.envs:LocalHomingEnv", 500),
+    "homing_gym/RouteFollowing-v0": ("homing_gym.envs:RouteFollowingEnv", 1000),
 }
 ENV_IDS: tuple[str, ...] = tuple(_ENVS)
 
@@ -28,6 +29,7 @@ def register_envs() -> None:
 register_envs()
 
 from homing_gym.env import HomingEnv  # noqa: E402
-from homing_gym.envs import LocalHomingEnv  # noqa: E402
+from homing_gym.envs import LocalHomingEnv, RouteFollowingEnv  # noqa: E402
 
-__all__ = ["ENV_IDS", "HomingEnv", "LocalHomingEnv", "register_envs", "__version__"]
+__all__ = ["ENV_IDS", "HomingEnv", "LocalHomingEnv", "RouteFollowingEnv", "register_envs",
+           "__version__"]

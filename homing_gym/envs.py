@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from homing_gym.env import HomingEnv
 from homing_gym.scenes.base import Scene
-from homing_gym.tasks import LocalHomingTask, RewardConfig
+from homing_gym.tasks import LocalHomingTask, RewardConfig, RouteFollowingTask
+from homing_gym.tasks.route_following import FOOT
 
 
 class LocalHomingEnv(HomingEnv):
@@ -86,7 +87,9 @@ class LocalHomingEnv(HomingEnv):
     ``"human"``: PyBullet GUI), ``obs_keys``, ``panorama_shape`` = (48, 256),
     ``vfov_deg`` = 60, ``n_views`` = 6, ``renderer`` (``"tiny"`` or ``"egl"``), ``omni_size`` = 128,
     ``action_type``, ``control_period``, ``physics_substeps``, ``max_speed``,
-    ``max_yaw_rate``, ``stop_threshold``, ``odometry_noise`` = 0.02,
+    ``max_yaw_rate``, ``stop_threshold``, ``odometry_noise`` = 0.02, ``lighting_change`` = 0
+    (0-1: strength of an illumination change between the home snapshot and the run, drawn
+    from the seed: light direction, brightness, contrast),
     ``start_distance``, ``success_radius``, ``success_on``, ``reward`` (a
     ``RewardConfig``), ``max_episode_steps``.
 
@@ -101,4 +104,78 @@ class LocalHomingEnv(HomingEnv):
                  reward: RewardConfig = RewardConfig(), **kwargs):
         task = LocalHomingTask(start_distance=start_distance, success_radius=success_radius,
                                success_on=success_on, reward=reward)
+        super().__init__(task, scene, **kwargs)
+
+
+class RouteFollowingEnv(HomingEnv):
+    """## Description
+
+    Route following by successive local homing (Hong et al. 1991 §5). A route of target
+    places was taught by taking a panoramic snapshot at each: by default 17 targets 1 ft
+    (0.3048 m) apart along the centre line of the ``hallway`` scene, all facing along the
+    corridor. The robot starts 1 ft before the first target and must home to each target
+    in turn; the goal observation is the snapshot of the current target and switches to
+    the next one when a target is reached.
+
+    ## Action space
+
+    As ``LocalHoming-v0``: ``Box(-1, 1, (2,), float32)`` (forward speed, yaw rate; max
+    0.3 m/s and 1.5 rad/s) or ``Discrete(4)`` with ``action_type="discrete"``; control
+    period 0.1 s.
+
+    ## Observation space
+
+    As ``LocalHoming-v0`` (``obs_keys``): ``panorama``, ``goal`` (the current target's
+    snapshot), optional ``omni``, ``goal_omni``, ``signature``, ``goal_signature``,
+    ``odometry`` (pose in the frame of the last target).
+
+    ## Rewards
+
+    ``progress * (d_prev - d)`` towards the current target (restarted at each switch)
+    ``+ waypoint`` for each intermediate target reached within the radius ``+ success``
+    for the last one ``- collision`` on each step with contact ``- time`` on each step;
+    defaults 1.0, 1.0, 10.0, 0.1, 0.01. Terms in ``info["rewards"]``.
+
+    ## Starting state
+
+    1 ft before the first target, on the route line, perturbed uniformly by up to
+    ``start_jitter`` = (0.05 m, 10 degrees) in x, y and heading, drawn from the seed.
+    With ``lighting_change > 0`` the lighting of the run differs from the lighting of
+    the snapshots.
+
+    ## Episode end
+
+    ``success_on="reach"`` (default): a target is reached when the robot centre comes
+    within ``success_radius`` = 0.1 m of it. ``success_on="stop"``: the agent signals
+    arrival with the stop action (discrete 3, or both continuous components below
+    ``stop_threshold``); the target is left whatever the distance, which is recorded as
+    its error. Terminated after the last target; a success if it was reached within
+    ``success_radius``. Truncated after 1000 steps.
+
+    ## Info
+
+    As ``LocalHoming-v0`` (``goal_pose`` and ``distance_to_goal`` refer to the current
+    target), plus ``target_index`` (0-based index of the current target) and
+    ``target_errors`` (distance in metres at which each finished target was left).
+
+    ## Arguments
+
+    ``scene`` (default ``"hallway"``; any scene with ``metadata["route_origin"]``),
+    ``n_targets`` = 17, ``spacing`` = 0.3048, ``start_jitter``, ``success_radius``,
+    ``success_on``, ``reward``, ``lighting_change`` = 0 (0-1: strength of the
+    illumination change between snapshots and run: light direction, brightness,
+    contrast), and every camera and robot argument of ``LocalHoming-v0``.
+
+    ## Version history
+
+    * v0: initial release.
+    """
+
+    def __init__(self, scene: str | Scene = "hallway", *, n_targets: int = 17,
+                 spacing: float = FOOT, start_jitter: tuple[float, float] = (0.05, 0.1745),
+                 success_radius: float = 0.1, success_on: str = "reach",
+                 reward: RewardConfig = RewardConfig(), **kwargs):
+        task = RouteFollowingTask(n_targets=n_targets, spacing=spacing,
+                                  start_jitter=start_jitter, success_radius=success_radius,
+                                  success_on=success_on, reward=reward)
         super().__init__(task, scene, **kwargs)

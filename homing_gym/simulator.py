@@ -99,7 +99,7 @@ class Simulator:
                          wall.color, wall.texture)
 
     def _make_landmark(self, lm: Landmark) -> int:
-        position = [lm.position[0], lm.position[1], lm.height / 2]
+        position = [lm.position[0], lm.position[1], lm.base + lm.height / 2]
         if lm.shape == "box":
             half = [lm.extent[0] / 2, lm.extent[1] / 2, lm.height / 2]
             return self._box(half, position, lm.yaw, lm.color, lm.texture)

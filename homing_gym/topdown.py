@@ -101,7 +101,7 @@ def compose_frame(topdown: np.ndarray, panorama: np.ndarray, goal: np.ndarray,
     size = topdown.shape[0]
     width = 2 * size
     right = np.concatenate([_labelled(panorama, "current view " + caption, width),
-                            _labelled(goal, "goal (home snapshot)", width)], axis=0)
+                            _labelled(goal, "goal snapshot", width)], axis=0)
     if right.shape[0] < size:
         right = np.concatenate(
             [right, np.full((size - right.shape[0], width, 3), BG, np.uint8)], axis=0)

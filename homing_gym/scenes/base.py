@@ -30,7 +30,8 @@ def _check_color(owner: str, color: Color) -> None:
 
 @dataclass(frozen=True)
 class Landmark:
-    """A static object on the floor.
+    """A static object: on the floor, or hanging with its bottom ``base`` metres above it
+    (posters, lamps).
 
     ``shape`` is ``"cylinder"`` (uses ``radius``) or ``"box"`` (uses ``extent`` =
     (length along its yaw, width), metres). ``position`` is the centre of its footprint.
@@ -45,9 +46,13 @@ class Landmark:
     color: Color = (0.85, 0.1, 0.1, 1.0)
     texture: str | None = None
     name: str = ""
+    base: float = 0.0
 
     def __post_init__(self) -> None:
         owner = f"landmark {self.name or self.position!r}"
+        if not (math.isfinite(self.base) and self.base >= 0):
+            raise ValueError(f"{owner}: base must be >= 0 metres above the floor, "
+                             f"got {self.base!r}")
         if self.shape not in SHAPES:
             raise ValueError(f"{owner}: unknown shape {self.shape!r}; allowed: {SHAPES}")
         if self.shape == "cylinder":
@@ -66,6 +71,15 @@ class Landmark:
         if self.shape == "cylinder":
             return self.radius
         return math.hypot(*self.extent) / 2
+
+    @property
+    def footprint_half_size(self) -> tuple[float, float]:
+        """Half width and half depth (metres) of the footprint's axis-aligned bounding box."""
+        if self.shape == "cylinder":
+            return self.radius, self.radius
+        c, s = abs(math.cos(self.yaw)), abs(math.sin(self.yaw))
+        a, b = self.extent[0] / 2, self.extent[1] / 2
+        return a * c + b * s, a * s + b * c
 
 
 @dataclass(frozen=True)
@@ -112,12 +126,12 @@ class Scene:
             raise ValueError(f"scene {self.name!r}: empty bounds {self.bounds!r}")
         for lm in self.landmarks:
             x, y = lm.position
-            r = lm.footprint_radius
-            if not (xmin <= x - r and x + r <= xmax and ymin <= y - r and y + r <= ymax):
+            hx, hy = lm.footprint_half_size
+            if not (xmin <= x - hx and x + hx <= xmax and ymin <= y - hy and y + hy <= ymax):
                 raise ValueError(
                     f"scene {self.name!r}: landmark {lm.name or ''} at {lm.position!r} "
-                    f"(footprint radius {r:.3f} m) lies outside the scene bounds "
-                    f"x in [{xmin}, {xmax}], y in [{ymin}, {ymax}]")
+                    f"(footprint half size {hx:.3f} x {hy:.3f} m) lies outside the scene "
+                    f"bounds x in [{xmin}, {xmax}], y in [{ymin}, {ymax}]")
         _check_color(f"scene {self.name!r} floor", self.floor_color)
         if self.floor_texture is not None:
             check_texture(self.floor_texture)

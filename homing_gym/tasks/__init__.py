@@ -3,6 +3,7 @@
 from homing_gym.tasks.base import Episode, Task, sample_free_pose
 from homing_gym.tasks.goal_reaching import SUCCESS_MODES, GoalReachingTask, RewardConfig
 from homing_gym.tasks.local_homing import LocalHomingTask
+from homing_gym.tasks.route_following import RouteFollowingTask
 
 __all__ = ["SUCCESS_MODES", "Episode", "GoalReachingTask", "LocalHomingTask", "RewardConfig",
-           "Task", "sample_free_pose"]
+           "RouteFollowingTask", "Task", "sample_free_pose"]
