@@ -1,1 +1,63 @@
-"""Scripted visual-homing controllers (filled in by the evaluation-harness issue)."""
+"""Scripted visual-homing controllers behind one interface, and their registry.
+
+>>> import baselines
+>>> baselines.available()
+['oracle', 'random']
+>>> controller = baselines.make("oracle", step_length=0.2)
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+from baselines.base import Controller
+from baselines.motion import MotionHelper, MotionSpec, Move
+from baselines.oracle import OracleController
+from baselines.random_walk import RandomController
+
+_REGISTRY: dict[str, type[Controller]] = {}
+
+
+def register(name: str, cls: type[Controller]) -> None:
+    """Make controller class ``cls`` available as ``baselines.make(name)``."""
+    if not (isinstance(cls, type) and issubclass(cls, Controller)):
+        raise TypeError(f"{cls!r} is not a Controller subclass")
+    cls.name = name
+    _REGISTRY[name] = cls
+
+
+def available() -> list[str]:
+    """Names of the registered controllers."""
+    return sorted(_REGISTRY)
+
+
+def controller_class(name: str) -> type[Controller]:
+    """The class registered under ``name``; ``ValueError`` listing the names if unknown."""
+    if name not in _REGISTRY:
+        raise ValueError(f"unknown controller {name!r}; available: {available()}")
+    return _REGISTRY[name]
+
+
+def parameters(name: str) -> dict[str, Any]:
+    """Parameter names of a controller with their default values."""
+    return {f.name: f.default for f in dataclasses.fields(controller_class(name))}
+
+
+def make(name: str, **params: Any) -> Controller:
+    """A new controller ``name`` with parameter overrides; ``ValueError`` on unknown names
+    or parameters."""
+    cls = controller_class(name)
+    unknown = sorted(set(params) - set(parameters(name)))
+    if unknown:
+        raise ValueError(f"controller {name!r} has no parameter(s) {unknown}; "
+                         f"parameters: {parameters(name)}")
+    return cls(**params)
+
+
+register("oracle", OracleController)
+register("random", RandomController)
+
+__all__ = ["Controller", "MotionHelper", "MotionSpec", "Move", "OracleController",
+           "RandomController", "available", "controller_class", "make", "parameters",
+           "register"]

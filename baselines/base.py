@@ -1,0 +1,109 @@
+"""The controller interface: stable-baselines3 call shape, paper-style moves inside.
+
+A scripted controller is a dataclass whose fields are its parameters (with the papers'
+defaults). The harness drives it exactly like a stable-baselines3 model::
+
+    action, state = controller.predict(observation, state=None, episode_start=True)
+
+Subclasses implement :meth:`Controller.decide`: from the current observation, return the
+next :class:`~baselines.motion.Move` (home vector: direction in the robot frame and step
+length) or ``None`` to stop (arrived). The base class executes each move over several env
+steps with the shared :class:`~baselines.motion.MotionHelper`, asks for the next decision
+once the move is done, and records the commanded direction in :attr:`last_direction`
+(used by the homing vector field).
+
+Controllers see the observation only. The harness gives an env handle only to
+controllers that declare ``needs_env = True`` (oracles, named as such), through
+:meth:`Controller.attach_env`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from abc import ABC, abstractmethod
+from typing import Any, ClassVar
+
+import numpy as np
+
+from baselines.motion import MOTION_STYLES, MotionHelper, MotionSpec, Move
+
+
+@dataclasses.dataclass
+class Controller(ABC):
+    """Base class of scripted controllers. Fields common to all of them:
+
+    ``motion``: ``"turn_then_drive"`` or ``"pursuit"`` (see :mod:`baselines.motion`).
+    """
+
+    motion: str = "turn_then_drive"
+
+    #: Registry name (set by :func:`baselines.register`).
+    name: ClassVar[str] = ""
+    #: True only for oracle controllers: the harness then calls :meth:`attach_env`.
+    needs_env: ClassVar[bool] = False
+
+    def __post_init__(self) -> None:
+        if self.motion not in MOTION_STYLES:
+            raise ValueError(f"{type(self).__name__}: unknown motion {self.motion!r}; "
+                             f"allowed: {MOTION_STYLES}")
+        self.validate()
+        self._helper = MotionHelper(MotionSpec(), self.motion)
+        self._queue: list = []
+        self._seed: int | None = None
+        self.last_direction: float | None = None
+        self.last_move: Move | None = None
+
+    # -- to override -----------------------------------------------------------------------
+    def validate(self) -> None:
+        """Check the parameter values; raise ``ValueError`` with a clear message."""
+
+    @abstractmethod
+    def decide(self, observation: dict[str, np.ndarray]) -> Move | None:
+        """The next move from the current observation, or ``None`` to stop."""
+
+    def on_reset(self) -> None:
+        """Clear per-episode memory (called by :meth:`reset`)."""
+
+    # -- the interface the harness uses ------------------------------------------------------
+    def configure(self, spec: MotionSpec) -> None:
+        """Tell the controller the env's command interface (action type and limits)."""
+        self._helper = MotionHelper(spec, self.motion)
+
+    @property
+    def motion_spec(self) -> MotionSpec:
+        return self._helper.spec
+
+    def attach_env(self, env) -> None:
+        """Only for ``needs_env`` controllers (oracles); others refuse."""
+        raise TypeError(f"controller {self.name or type(self).__name__!r} decides from "
+                        f"observations only and must not be given the env")
+
+    def reset(self, seed: int | None = None) -> None:
+        """Start a new episode: forget the current move and per-episode memory.
+        ``seed`` (the episode seed) makes stochastic controllers reproducible."""
+        self._queue = []
+        self._seed = seed
+        self.last_direction = None
+        self.last_move = None
+        self.on_reset()
+
+    def predict(self, observation: dict[str, np.ndarray], state: Any = None,
+                episode_start: Any = None, deterministic: bool = True) -> tuple[Any, Any]:
+        """The next env action, stable-baselines3 style. ``episode_start`` true resets
+        the controller (as :meth:`reset` without a seed). Returns ``(action, state)``."""
+        if episode_start is not None and bool(np.any(episode_start)):
+            self.reset(self._seed)
+        if not self._queue:
+            move = self.decide(observation)
+            self.last_move = move
+            if move is None:
+                return self._helper.stop_action(), state
+            self.last_direction = float(move.direction)
+            self._queue = self._helper.plan(move)
+            if not self._queue:  # a move below the command resolution: stop this step
+                return self._helper.stop_action(), state
+        return self._queue.pop(0), state
+
+    def params(self) -> dict[str, Any]:
+        """The parameter values (dataclass fields) as a plain dict."""
+        return dataclasses.asdict(self)

@@ -1,0 +1,176 @@
+"""Ground-truth shortest paths on the floor of a scene (for the oracle and for SPL).
+
+``shortest_path(scene, start, goal, radius)`` returns the waypoints of a short
+collision-free path for a disc of ``radius`` metres: the straight segment when it is free
+(exact), otherwise an 8-connected A* path on an occupancy grid (``resolution`` metres)
+shortened by line-of-sight string pulling and then tightened like a taut string (any-angle; a few millimetres
+longer than the true shortest path). Obstacles are what :func:`homing_gym.scenes.base.clearance` sees:
+walls, landmarks and the scene bounds.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from functools import lru_cache
+
+import numpy as np
+
+from homing_gym.scenes.base import Scene, clearance
+
+SQRT2 = math.sqrt(2.0)
+
+
+class NoPathError(ValueError):
+    """Start and goal are not connected for a disc of the given radius."""
+
+
+@lru_cache(maxsize=16)
+def occupancy(scene: Scene, radius: float, resolution: float) -> tuple[np.ndarray, tuple]:
+    """Boolean grid, True where a disc of ``radius`` centred on the cell fits; and the
+    grid origin ``(xmin, ymin)`` (centre of cell (0, 0)). Cached per scene."""
+    (xmin, ymin), (xmax, ymax) = scene.bounds
+    nx = int(math.floor((xmax - xmin) / resolution)) + 1
+    ny = int(math.floor((ymax - ymin) / resolution)) + 1
+    free = np.zeros((nx, ny), bool)
+    for i in range(nx):
+        for j in range(ny):
+            free[i, j] = clearance(scene, (xmin + i * resolution, ymin + j * resolution)) >= radius
+    return free, (xmin, ymin)
+
+
+def segment_free(scene: Scene, a, b, radius: float, step: float = 0.01) -> bool:
+    """Whether a disc of ``radius`` can slide from ``a`` to ``b`` (checked every ``step`` m;
+    extra coordinates such as a yaw are ignored)."""
+    a, b = (float(a[0]), float(a[1])), (float(b[0]), float(b[1]))
+    n = max(1, int(math.ceil(math.dist(a, b) / step)))
+    return all(clearance(scene, (a[0] + (b[0] - a[0]) * k / n, a[1] + (b[1] - a[1]) * k / n))
+               >= radius for k in range(n + 1))
+
+
+def path_length(points) -> float:
+    """Length (metres) of a polyline given as a sequence of (x, y, ...) points."""
+    pts = np.asarray(points, dtype=np.float64)
+    if len(pts) < 2:
+        return 0.0
+    return float(np.sum(np.hypot(*np.diff(pts[:, :2], axis=0).T)))
+
+
+def shortest_path(scene: Scene, start, goal, radius: float = 0.16,
+                  resolution: float = 0.02) -> list[tuple[float, float]]:
+    """Waypoints ``[start, ..., goal]`` (metres) of a short free path; see the module doc.
+
+    Raises :class:`NoPathError` when the grid search finds no connection.
+    """
+    a, b = (float(start[0]), float(start[1])), (float(goal[0]), float(goal[1]))
+    if segment_free(scene, a, b, radius):
+        return [a, b]
+    free, (x0, y0) = occupancy(scene, radius, resolution)
+    nx, ny = free.shape
+
+    def cell(p) -> tuple[int, int]:
+        return (min(nx - 1, max(0, int(round((p[0] - x0) / resolution)))),
+                min(ny - 1, max(0, int(round((p[1] - y0) / resolution)))))
+
+    def centre(c) -> tuple[float, float]:
+        return x0 + c[0] * resolution, y0 + c[1] * resolution
+
+    src, dst = cell(a), cell(b)
+    free = free.copy()  # a robot pushed near an obstacle may still leave: free its surroundings
+    for c in (src, dst):
+        free[max(0, c[0] - 3):c[0] + 4, max(0, c[1] - 3):c[1] + 4] = True
+    cells = _astar(free, src, dst)
+    if cells is None:
+        raise NoPathError(f"no free path for radius {radius} m from {a} to {b} "
+                          f"in scene {scene.name!r}")
+    points = [a] + [centre(c) for c in cells[1:-1]] + [b]
+    visible = lambda p, q: segment_free(scene, p, q, radius)  # noqa: E731
+    return _tighten(_subdivide(_string_pull(points, visible), 4 * resolution), visible)
+
+
+def _astar(free: np.ndarray, src, dst) -> list | None:
+    """8-connected A* on the grid; the start and goal cells count as free."""
+    nx, ny = free.shape
+    steps = [(1, 0, 1.0), (-1, 0, 1.0), (0, 1, 1.0), (0, -1, 1.0),
+             (1, 1, SQRT2), (1, -1, SQRT2), (-1, 1, SQRT2), (-1, -1, SQRT2)]
+
+    def h(c) -> float:
+        dx, dy = abs(c[0] - dst[0]), abs(c[1] - dst[1])
+        return max(dx, dy) + (SQRT2 - 1) * min(dx, dy)
+
+    g = {src: 0.0}
+    parent = {src: None}
+    heap = [(h(src), src)]
+    done = set()
+    while heap:
+        _, c = heapq.heappop(heap)
+        if c == dst:
+            path = [c]
+            while parent[path[-1]] is not None:
+                path.append(parent[path[-1]])
+            return path[::-1]
+        if c in done:
+            continue
+        done.add(c)
+        for dx, dy, cost in steps:
+            n = (c[0] + dx, c[1] + dy)
+            if not (0 <= n[0] < nx and 0 <= n[1] < ny) or n in done:
+                continue
+            if not free[n] and n != dst:
+                continue
+            ng = g[c] + cost
+            if ng < g.get(n, math.inf):
+                g[n] = ng
+                parent[n] = c
+                heapq.heappush(heap, (ng + h(n), n))
+    return None
+
+
+def _string_pull(points: list, visible) -> list:
+    """Keep from each kept waypoint only the farthest later one it can see
+    (``visible(p, q)``: the straight move p -> q is free)."""
+    kept = [points[0]]
+    i = 0
+    while i < len(points) - 1:
+        j = len(points) - 1
+        while j > i + 1 and not visible(points[i], points[j]):
+            j -= 1
+        kept.append(points[j])
+        i = j
+    return kept
+
+
+def _tighten(points: list, visible, rounds: int = 100, tol: float = 1e-4) -> list:
+    """Pull each inner waypoint towards the chord of its neighbours while both legs stay
+    free, until the length stops shrinking; then drop the waypoints that can be skipped."""
+    pts = [tuple(p) for p in points]
+    length = path_length(pts)
+    for _ in range(rounds):
+        i = 1
+        while i < len(pts) - 1:
+            a, p, b = pts[i - 1], pts[i], pts[i + 1]
+            ab = (b[0] - a[0], b[1] - a[1])
+            t = max(0.0, min(1.0, ((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1])
+                             / (ab[0] ** 2 + ab[1] ** 2)))
+            m = (a[0] + t * ab[0], a[1] + t * ab[1])
+            for f in (0.5, 0.25, 0.125, 0.0625):
+                q = (p[0] + f * (m[0] - p[0]), p[1] + f * (m[1] - p[1]))
+                if visible(a, q) and visible(q, b):
+                    pts[i] = q
+                    break
+            i += 1
+        new = path_length(pts)
+        if length - new < tol:
+            break
+        length = new
+    return _string_pull(pts, visible)
+
+
+def _subdivide(points: list, max_step: float) -> list:
+    """Insert evenly spaced points so that no leg is longer than ``max_step`` metres."""
+    out = [points[0]]
+    for p, q in zip(points[:-1], points[1:]):
+        n = max(1, int(math.ceil(math.dist(p, q) / max_step)))
+        out += [(p[0] + (q[0] - p[0]) * k / n, p[1] + (q[1] - p[1]) * k / n)
+                for k in range(1, n + 1)]
+    return out

@@ -1,0 +1,116 @@
+"""Controllers: registry, motion helper, oracle and random."""
+
+import math
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import baselines
+from baselines.motion import MotionHelper, MotionSpec, Move, integrate
+from train.evaluate import prepare_policy, run_episode
+from train.policies import parse_params
+
+ENV_ID = "homing_gym/LocalHoming-v0"
+
+
+def test_registry_lists_and_makes_controllers():
+    assert {"oracle", "random"} <= set(baselines.available())
+    c = baselines.make("oracle", step_length=0.2)
+    assert c.step_length == 0.2 and c.needs_env
+    assert not baselines.make("random").needs_env
+    with pytest.raises(ValueError, match="available"):
+        baselines.make("nope")
+    with pytest.raises(ValueError, match="no parameter"):
+        baselines.make("random", speed=3)
+    with pytest.raises(ValueError, match="step_length"):
+        baselines.make("random", step_length=-1.0)
+
+
+def test_parse_params_types_and_errors():
+    assert parse_params(["step_length=0.25", "align_heading=false"], "oracle") == {
+        "step_length": 0.25, "align_heading": False}
+    assert parse_params(["seed=7"], "random") == {"seed": 7}
+    with pytest.raises(ValueError, match="key=value"):
+        parse_params(["step_length"], "oracle")
+    with pytest.raises(ValueError, match="no parameter"):
+        parse_params(["speed=1"], "oracle")
+    with pytest.raises(ValueError, match="float"):
+        parse_params(["step_length=far"], "oracle")
+
+
+@pytest.mark.parametrize("action_type", ["continuous", "discrete"])
+@pytest.mark.parametrize("style", ["turn_then_drive", "pursuit"])
+def test_motion_helper_reaches_the_move_target_kinematically(action_type, style):
+    spec = MotionSpec(action_type=action_type)
+    helper = MotionHelper(spec, style)
+    # discrete moves are quantised to one step: 0.03 m and 0.15 rad
+    tol = 0.01 if action_type == "continuous" else 0.06
+    for direction in (0.0, 0.7, -1.9, 3.0):
+        for distance in (0.0, 0.1, 0.45):
+            actions = helper.plan(Move(direction, distance))
+            pose = integrate(actions, spec)
+            if distance > 0:
+                assert math.hypot(pose[0] - distance * math.cos(direction),
+                                  pose[1] - distance * math.sin(direction)) < tol
+            else:
+                assert abs(pose[2] - direction) < (0.01 if action_type == "continuous" else 0.08)
+            for a in actions:  # no planned action may read as the stop signal
+                if action_type == "continuous":
+                    assert max(abs(a[0]), abs(a[1])) >= spec.stop_threshold
+                else:
+                    assert a != 3
+
+
+def test_bad_moves_and_styles_raise():
+    with pytest.raises(ValueError):
+        Move(0.0, -1.0)
+    with pytest.raises(ValueError):
+        Move(math.nan, 1.0)
+    with pytest.raises(ValueError, match="motion"):
+        baselines.make("random", motion="teleport")
+
+
+def test_random_controller_is_reproducible_per_episode_seed():
+    def directions(seed):
+        c = baselines.make("random")
+        c.reset(seed)
+        out = []
+        for _ in range(40):
+            c.predict({})
+            out.append(c.last_direction)
+        return out
+
+    assert directions(5) == directions(5)
+    assert directions(5) != directions(6)
+
+
+def test_non_oracle_refuses_the_env():
+    with pytest.raises(TypeError, match="observations only"):
+        baselines.make("random").attach_env(object())
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_oracle_reaches_home_and_stops_there(seed):
+    env = gym.make(ENV_ID, success_on="stop", max_episode_steps=300)
+    try:
+        oracle = baselines.make("oracle")
+        prepare_policy(oracle, env)
+        record = run_episode(env, oracle, seed)
+    finally:
+        env.close()
+    assert record.success and record.terminated
+    assert record.final_distance < 0.06
+    assert record.final_heading_error_deg < 6.0
+    assert record.path_length < 1.3 * record.shortest_path + 0.1
+
+
+def test_oracle_discrete_actions_reach_home():
+    env = gym.make(ENV_ID, action_type="discrete", max_episode_steps=300)
+    try:
+        oracle = baselines.make("oracle")
+        prepare_policy(oracle, env)
+        record = run_episode(env, oracle, 4)
+    finally:
+        env.close()
+    assert record.success and record.final_distance < 0.15

@@ -1,0 +1,169 @@
+"""The harness: paired episodes, information isolation, JSON/CSV, CLIs, pictures."""
+
+import csv
+import json
+from dataclasses import dataclass
+from typing import ClassVar
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+from baselines import Controller
+from baselines.motion import Move
+from train import compare as compare_cli
+from train import evaluate as eval_cli
+from train import field as field_cli
+from train.evaluate import EvalResult, evaluate
+
+ENV_ID = "homing_gym/LocalHoming-v0"
+SHORT = {"max_episode_steps": 8}
+
+
+@dataclass
+class SpyController(Controller):
+    """Records every argument it is handed; refuses the env like any non-oracle."""
+
+    calls: ClassVar[list] = []
+
+    def decide(self, observation):
+        return Move(0.5, 0.1)
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        SpyController.calls.append((observation, state, episode_start, deterministic))
+        return super().predict(observation, state, episode_start, deterministic)
+
+
+def _walk(obj, depth=0):
+    """Every object reachable through containers and instance attributes."""
+    yield obj
+    if depth > 4:
+        return
+    if isinstance(obj, dict):
+        children = list(obj.values())
+    elif isinstance(obj, (list, tuple)):
+        children = list(obj)
+    elif hasattr(obj, "__dict__") and not isinstance(obj, type):
+        children = list(vars(obj).values())
+    else:
+        children = []
+    for child in children:
+        yield from _walk(child, depth + 1)
+
+
+def test_non_oracle_controllers_get_only_the_observation():
+    SpyController.calls.clear()
+    spy = SpyController()
+    evaluate(spy, ENV_ID, episodes=2, seed=0, env_kwargs=SHORT, progress=False)
+    assert len(SpyController.calls) == 2 * SHORT["max_episode_steps"]
+    for observation, state, episode_start, _ in SpyController.calls:
+        assert set(observation) == {"panorama", "goal"}
+        assert all(isinstance(v, np.ndarray) for v in observation.values())
+        assert state is None and isinstance(episode_start, bool)
+    # nothing the controller holds or was handed leads to the env, its simulator or info
+    forbidden = (gym.Env,)
+    from homing_gym.simulator import Simulator
+    for obj in list(_walk(SpyController.calls)) + list(_walk(spy)):
+        assert not isinstance(obj, forbidden + (Simulator,))
+        assert not (isinstance(obj, dict) and {"pose", "goal_pose"} & set(obj))
+
+
+def test_same_seed_gives_identical_episodes_across_policies():
+    a = evaluate("oracle", ENV_ID, episodes=3, seed=11, env_kwargs=SHORT, progress=False)
+    b = evaluate("random", ENV_ID, episodes=3, seed=11, env_kwargs=SHORT, progress=False)
+    assert [e.seed for e in a.episodes] == [11, 12, 13]
+    assert [e.start_pose for e in a.episodes] == [e.start_pose for e in b.episodes]
+    assert [e.home_pose for e in a.episodes] == [e.home_pose for e in b.episodes]
+    assert len({tuple(e.home_pose) for e in a.episodes}) == 3
+    c = evaluate("random", ENV_ID, episodes=1, seed=12, env_kwargs=SHORT, progress=False)
+    assert c.episodes[0].start_pose == b.episodes[1].start_pose
+
+
+def test_workers_give_the_same_records_as_one_process():
+    one = evaluate("random", ENV_ID, episodes=3, seed=0, env_kwargs=SHORT, progress=False)
+    two = evaluate("random", ENV_ID, episodes=3, seed=0, env_kwargs=SHORT, workers=2,
+                   progress=False)
+    strip = lambda r: [(e.seed, e.trajectory, e.success) for e in r.episodes]  # noqa: E731
+    assert strip(one) == strip(two)
+
+
+def test_eval_cli_writes_json_and_csv(tmp_path, capsys):
+    out = tmp_path / "r.json"
+    assert eval_cli.main(["--policy", "random", "--param", "step_length=0.15", "--episodes", "2",
+                          "--seed", "4", "--env-kwargs", json.dumps(SHORT), "--quiet",
+                          "--out", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    assert doc["schema"] == 1 and doc["policy"] == "random" and doc["seed"] == 4
+    assert doc["params"]["step_length"] == 0.15 and doc["env_kwargs"] == SHORT
+    for key in ("episodes", "success_rate", "success_ci", "spl", "soft_spl",
+                "final_distance_mean", "path_length_mean", "steps_mean", "success_by_distance"):
+        assert key in doc["summary"]
+    assert [e["seed"] for e in doc["episodes"]] == [4, 5]
+    assert all(e["steps"] == 8 and len(e["trajectory"]) == 9 for e in doc["episodes"])
+    rows = list(csv.DictReader(open(tmp_path / "r.csv")))
+    assert [r["seed"] for r in rows] == ["4", "5"] and "trajectory" not in rows[0]
+    assert EvalResult.load(str(out)).summary == doc["summary"]
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--policy", "nope"], "oracle"),
+    (["--policy", "oracle", "--param", "oops"], "key=value"),
+    (["--policy", "oracle", "--env-kwargs", "{bad"], "JSON object"),
+])
+def test_eval_cli_rejects_bad_input(tmp_path, capsys, argv, message):
+    with pytest.raises(SystemExit) as err:
+        eval_cli.main(argv + ["--out", str(tmp_path / "x.json")])
+    assert err.value.code == 2
+    assert message in capsys.readouterr().err
+
+
+def test_load_rejects_bad_json(tmp_path):
+    bad = tmp_path / "bad.json"
+    bad.write_text("{not json")
+    with pytest.raises(ValueError, match="bad.json"):
+        EvalResult.load(str(bad))
+    bad.write_text(json.dumps({"schema": 99}))
+    with pytest.raises(ValueError, match="schema"):
+        EvalResult.load(str(bad))
+
+
+def test_compare_writes_table_and_pngs(tmp_path):
+    paths = []
+    for name in ("oracle", "random"):
+        r = evaluate(name, ENV_ID, episodes=2, seed=0, env_kwargs={"max_episode_steps": 40},
+                     progress=False)
+        paths.append(str(tmp_path / f"{name}.json"))
+        r.save(paths[-1])
+    assert compare_cli.main(paths + ["--out", str(tmp_path / "cmp"), "--trajectories", "2"]) == 0
+    table = (tmp_path / "cmp" / "table.md").read_text().splitlines()
+    assert table[2].startswith("| oracle |") and table[3].startswith("| random |")
+    for png in ("success_vs_distance.png", "final_distance.png", "trajectories.png"):
+        assert (tmp_path / "cmp" / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_field_of_oracle_points_home_and_random_does_not(tmp_path):
+    out = tmp_path / "field.png"
+    assert field_cli.main(["--policy", "oracle", "--grid", "0.6", "--quiet",
+                           "--out", str(out)]) == 0
+    assert out.read_bytes()[:4] == b"\x89PNG"
+    scores = json.loads((tmp_path / "field.json").read_text())
+    assert len(scores["points"]) >= 8
+    assert scores["aae_deg"] < 25 and scores["homeward"] > 0.85
+    assert scores["return_ratio"] == 1.0
+    rnd = field_cli.homing_field("random", grid=0.6, run_to_end=False, progress=False)
+    assert rnd.aae_deg > 45 and rnd.return_ratio is None
+
+
+def test_sb3_model_zip_is_evaluated(tmp_path):
+    sb3 = pytest.importorskip("stable_baselines3")
+    env = gym.make(ENV_ID)
+    model = sb3.PPO("MultiInputPolicy", env, n_steps=8, batch_size=8, device="cpu")
+    path = tmp_path / "ppo_tiny.zip"
+    model.save(path)
+    env.close()
+    result = evaluate(str(path), ENV_ID, episodes=1, seed=0, env_kwargs={"max_episode_steps": 3},
+                      progress=False)
+    assert result.policy == "ppo_tiny" and result.episodes[0].steps == 3
+    with pytest.raises(ValueError, match="observation_space"):
+        evaluate(str(path), ENV_ID, episodes=1, env_kwargs={"obs_keys": ["signature"]},
+                 progress=False)

@@ -1,0 +1,97 @@
+"""Metrics against hand-computed values on hand-made trajectories."""
+
+import math
+
+import numpy as np
+import pytest
+
+from baselines.planning import segment_free, shortest_path
+from homing_gym.scenes.arena import arena_scene
+from train.evaluate import EpisodeRecord, summarize
+from train.metrics import bootstrap_ci, distance_bins, path_length, soft_spl, spl
+
+# a 3-4-5 detour: straight-line distance 5, travelled 7
+TRAJECTORY = [(0.0, 0.0), (3.0, 0.0), (3.0, 4.0)]
+
+
+def test_path_length_of_hand_made_trajectory():
+    assert path_length(TRAJECTORY) == pytest.approx(7.0)
+    assert path_length([(1.0, 1.0)]) == 0.0
+    assert path_length([(0, 0, 0.3), (0, 2, 1.0)]) == pytest.approx(2.0)  # yaw ignored
+
+
+def test_spl_hand_computed():
+    assert spl(True, 5.0, path_length(TRAJECTORY)) == pytest.approx(5 / 7)
+    assert spl(False, 5.0, 7.0) == 0.0
+    assert spl(True, 5.0, 4.0) == 1.0  # stopped short inside the success radius
+    with pytest.raises(ValueError):
+        spl(True, -1.0, 2.0)
+
+
+def test_soft_spl_hand_computed():
+    # ends 1 m from home after 7 m for a 5 m shortest path: (1 - 1/5) * 5/7
+    assert soft_spl(1.0, 5.0, 7.0) == pytest.approx(0.8 * 5 / 7)
+    assert soft_spl(0.0, 5.0, 5.0) == pytest.approx(1.0)
+    assert soft_spl(6.0, 5.0, 9.0) == 0.0  # further than at the start: clipped at 0
+
+
+def test_distance_bins_hand_computed():
+    bins = distance_bins([0.1, 0.35, 0.59, 0.61, 1.2], [1, 0, 1, 1, 0], width=0.3)
+    assert [(b.lo, b.hi, b.n, b.success_rate) for b in bins] == [
+        (0.0, 0.3, 1, 1.0), (0.3, 0.6, 2, 0.5), (0.6, 0.9, 1, 1.0), (1.2, 1.5, 1, 0.0)]
+    with pytest.raises(ValueError):
+        distance_bins([0.1], [1], width=0)
+
+
+def test_bootstrap_ci_hand_computed_cases():
+    assert bootstrap_ci([0.7] * 10) == (0.7, 0.7)
+    # two values 0 and 1: resampled means are 0, 0.5, 1 with probabilities 1/4, 1/2, 1/4,
+    # so the 2.5th and 97.5th percentiles are 0 and 1
+    assert bootstrap_ci([0.0, 1.0]) == (0.0, 1.0)
+    assert all(math.isnan(v) for v in bootstrap_ci([]))
+
+
+def test_bootstrap_ci_matches_normal_approximation_and_is_seeded():
+    x = np.array([0, 1] * 500, dtype=float)  # p = 0.5, n = 1000
+    lo, hi = bootstrap_ci(x, seed=3)
+    half = 1.96 * math.sqrt(0.25 / 1000)
+    assert lo == pytest.approx(0.5 - half, abs=0.006)
+    assert hi == pytest.approx(0.5 + half, abs=0.006)
+    assert bootstrap_ci(x, seed=3) == (lo, hi)
+
+
+def _record(seed, success, start_distance, spl_value, final_distance=0.1):
+    return EpisodeRecord(seed=seed, start_pose=[0, 0, 0], home_pose=[1, 0, 0],
+                         start_distance=start_distance, shortest_path=start_distance,
+                         success=success, terminated=success, truncated=not success, steps=10,
+                         path_length=1.0, final_distance=final_distance, min_distance=0.1,
+                         collisions=0, spl=spl_value, soft_spl=0.5,
+                         final_heading_error_deg=10.0, wall_time=0.1)
+
+
+def test_summary_means_and_bins():
+    records = [_record(0, True, 0.4, 0.8), _record(1, False, 0.5, 0.0),
+               _record(2, True, 1.0, 0.6, final_distance=0.3)]
+    s = summarize(records, bin_width=0.3)
+    assert s["episodes"] == 3
+    assert s["success_rate"] == pytest.approx(2 / 3)
+    assert s["spl"] == pytest.approx(1.4 / 3)
+    assert s["final_distance_mean"] == pytest.approx(0.5 / 3)
+    assert s["final_distance_cm_median"] == pytest.approx(10.0)
+    lo, hi = s["success_ci"]
+    assert 0 <= lo <= 2 / 3 <= hi <= 1
+    assert [(b["lo"], b["n"], b["success_rate"]) for b in s["success_by_distance"]] == [
+        (0.3, 2, 0.5), (0.9, 1, 1.0)]
+
+
+def test_shortest_path_is_straight_when_free_and_bends_around_a_cylinder():
+    scene = arena_scene()
+    assert path_length(shortest_path(scene, (-0.9, -0.9), (-0.9, 0.2))) == pytest.approx(1.1)
+    # cylinder at (0.45, 0.35), radius 0.1075, inflated by the 0.16 m body radius; start and
+    # goal 0.45 m either side of its centre: two tangents and an arc
+    r, d = 0.1075 + 0.16, 0.45
+    tangent = math.sqrt(d * d - r * r)
+    arc = r * (math.pi - 2 * math.acos(r / d))
+    path = shortest_path(scene, (0.9, 0.35), (0.0, 0.35), radius=0.16)
+    assert path_length(path) == pytest.approx(2 * tangent + arc, rel=0.01)
+    assert all(segment_free(scene, a, b, 0.16 - 1e-6) for a, b in zip(path[:-1], path[1:]))

@@ -1,0 +1,193 @@
+"""Compare evaluation results: a Markdown table with CIs and PNG plots.
+
+Command line (also ``python -m train.compare``)::
+
+    homing-compare results/oracle.json results/random.json --out comparison/
+
+writes ``comparison/table.md``, ``success_vs_distance.png``, ``final_distance.png`` and
+``trajectories.png``. Trajectories are read from the result JSONs (every episode stores its
+path); the scene of each shown episode is rebuilt with ``env.reset(seed)``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import warnings
+from typing import Sequence
+
+import cv2
+import gymnasium as gym
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from homing_gym.topdown import HOME, MapCanvas, draw_pose, draw_scene  # noqa: E402
+from train.evaluate import EvalResult  # noqa: E402
+
+COLORS = plt.get_cmap("tab10").colors
+
+
+def _ci(summary: dict, key: str, ci_key: str, scale: float = 1.0, fmt: str = ".2f") -> str:
+    lo, hi = summary[ci_key]
+    return f"{scale * summary[key]:{fmt}} [{scale * lo:{fmt}}, {scale * hi:{fmt}}]"
+
+
+def markdown_table(results: Sequence[EvalResult]) -> str:
+    """One row per method: means with 95% bootstrap CIs."""
+    head = ("| method | episodes | success % [95% CI] | SPL | soft-SPL | final distance (cm) "
+            "| heading error (deg) | path length (m) | steps | collisions / episode |")
+    rows = [head, "|---|" + "---:|" * (head.count("|") - 2)]
+    for r in results:
+        s = r.summary
+        rows.append(
+            f"| {r.policy} | {s['episodes']} | {_ci(s, 'success_rate', 'success_ci', 100, '.1f')} "
+            f"| {_ci(s, 'spl', 'spl_ci', fmt='.3f')} | {_ci(s, 'soft_spl', 'soft_spl_ci', fmt='.3f')} "
+            f"| {_ci(s, 'final_distance_mean', 'final_distance_ci', 100, '.1f')} "
+            f"| {_ci(s, 'heading_error_deg_mean', 'heading_error_deg_ci', fmt='.1f')} "
+            f"| {_ci(s, 'path_length_mean', 'path_length_ci')} "
+            f"| {_ci(s, 'steps_mean', 'steps_ci', fmt='.0f')} "
+            f"| {_ci(s, 'collisions_mean', 'collisions_ci')} |")
+    return "\n".join(rows) + "\n"
+
+
+def check_paired(results: Sequence[EvalResult]) -> list[int]:
+    """Seeds present in every result (the paired episodes); warns if the suites differ."""
+    envs = {(r.env_id, repr(sorted(r.env_kwargs.items()))) for r in results}
+    if len(envs) > 1:
+        warnings.warn(f"results come from different envs or env kwargs: {sorted(envs)}",
+                      stacklevel=2)
+    seeds = [set(e.seed for e in r.episodes) for r in results]
+    shared = sorted(set.intersection(*seeds))
+    if any(s != seeds[0] for s in seeds):
+        warnings.warn(f"results cover different episode seeds; {len(shared)} shared",
+                      stacklevel=2)
+    return shared
+
+
+def plot_success_vs_distance(results: Sequence[EvalResult], path: str) -> None:
+    """Success rate (with 95% CI) against start distance, one line per method."""
+    fig, ax = plt.subplots(figsize=(5.5, 3.6), dpi=100)
+    for i, r in enumerate(results):
+        bins = r.summary["success_by_distance"]
+        x = [100 * (b["lo"] + b["hi"]) / 2 for b in bins]
+        y = [100 * b["success_rate"] for b in bins]
+        err = [[100 * (b["success_rate"] - b["success_ci"][0]) for b in bins],
+               [100 * (b["success_ci"][1] - b["success_rate"]) for b in bins]]
+        ax.errorbar(x, y, yerr=err, marker="o", capsize=3, color=COLORS[i % 10], label=r.policy)
+    ax.set_xlabel("start distance from home (cm)")
+    ax.set_ylabel("success rate (%)")
+    ax.set_ylim(-3, 103)
+    ax.grid(alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def plot_final_distance(results: Sequence[EvalResult], path: str) -> None:
+    """Empirical CDF of the final distance to home, one line per method."""
+    fig, ax = plt.subplots(figsize=(5.5, 3.6), dpi=100)
+    for i, r in enumerate(results):
+        d = np.sort([100 * e.final_distance for e in r.episodes])
+        ax.step(d, np.arange(1, d.size + 1) / d.size, where="post", color=COLORS[i % 10],
+                label=r.policy)
+    radius = results[0].env_kwargs.get("success_radius", 0.15)
+    ax.axvline(100 * radius, color="grey", ls="--", lw=1, label="success radius")
+    ax.set_xlabel("final distance to home (cm)")
+    ax.set_ylabel("fraction of episodes")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def plot_trajectories(results: Sequence[EvalResult], seeds: Sequence[int], path: str,
+                      size: int = 300) -> None:
+    """Top-down maps of the episodes ``seeds``: every method's path in its colour."""
+    first = results[0]
+    env = gym.make(first.env_id, **first.env_kwargs)
+    panels = []
+    try:
+        for seed in seeds:
+            env.reset(seed=seed)
+            scene = env.unwrapped.scene
+            canvas = MapCanvas(scene, size)
+            img = draw_scene(scene, canvas)
+            for i, r in enumerate(results):
+                episode = next(e for e in r.episodes if e.seed == seed)
+                color = tuple(int(255 * c) for c in COLORS[i % 10])
+                pts = np.array([canvas.px(x, y) for x, y in episode.trajectory], np.int32)
+                cv2.polylines(img, [pts], False, color, 2, cv2.LINE_AA)
+            shown = next(e for e in first.episodes if e.seed == seed)
+            radius = env.unwrapped.robot_config.body_radius
+            draw_pose(img, canvas, shown.home_pose, radius, HOME, filled=False)
+            draw_pose(img, canvas, shown.start_pose, radius, (120, 120, 120), filled=False)
+            panels.append((seed, img))
+    finally:
+        env.close()
+    cols = min(len(panels), 3)
+    rows = (len(panels) + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(3.2 * cols, 3.2 * rows + 0.5), dpi=90,
+                             squeeze=False)
+    for ax in axes.flat:
+        ax.axis("off")
+    for ax, (seed, img) in zip(axes.flat, panels):
+        ax.imshow(img)
+        ax.set_title(f"episode seed {seed}", fontsize=9)
+    handles = [plt.Line2D([], [], color=COLORS[i % 10], lw=2, label=r.policy)
+               for i, r in enumerate(results)]
+    handles += [plt.Line2D([], [], color=np.array(HOME) / 255, marker="o", ls="", mfc="none",
+                           label="home"),
+                plt.Line2D([], [], color="grey", marker="o", ls="", mfc="none", label="start")]
+    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8,
+               frameon=False)
+    fig.tight_layout(rect=(0, 0.06, 1, 1))
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def compare(paths: Sequence[str], out: str, trajectories: int = 3) -> dict[str, str]:
+    """Write the table and plots for the result files ``paths`` into ``out``; returns
+    the written file paths by kind."""
+    if not paths:
+        raise ValueError("give at least one result JSON")
+    results = [EvalResult.load(p) for p in paths]
+    shared = check_paired(results)
+    os.makedirs(out, exist_ok=True)
+    written = {"table": os.path.join(out, "table.md"),
+               "success_vs_distance": os.path.join(out, "success_vs_distance.png"),
+               "final_distance": os.path.join(out, "final_distance.png")}
+    with open(written["table"], "w") as f:
+        f.write(markdown_table(results))
+    plot_success_vs_distance(results, written["success_vs_distance"])
+    plot_final_distance(results, written["final_distance"])
+    if trajectories > 0 and shared:
+        written["trajectories"] = os.path.join(out, "trajectories.png")
+        plot_trajectories(results, shared[:trajectories], written["trajectories"])
+    return written
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="homing-compare", description=__doc__.split("\n")[0])
+    parser.add_argument("results", nargs="+", help="result JSON files of homing-eval")
+    parser.add_argument("--out", required=True, help="output directory")
+    parser.add_argument("--trajectories", type=int, default=3,
+                        help="number of shared episodes drawn on the top-down map")
+    args = parser.parse_args(argv)
+    try:
+        written = compare(args.results, args.out, args.trajectories)
+    except ValueError as err:
+        parser.exit(2, f"homing-compare: error: {err}\n")
+    with open(written["table"]) as f:
+        print(f.read())
+    print("wrote " + ", ".join(written.values()))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

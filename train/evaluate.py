@@ -1,0 +1,391 @@
+"""The evaluation harness: one loop that scores every method on identical episodes.
+
+Episode ``i`` of a suite with seed ``S`` is ``env.reset(seed=S + i)``, so every method sees
+the same scenes, homes and starts. Policies see only the observation; the harness alone
+reads ``info`` and the env's ground truth to compute the metrics of :mod:`train.metrics`.
+
+Command line (also ``python -m train.evaluate``)::
+
+    homing-eval --policy oracle --env homing_gym/LocalHoming-v0 --episodes 200 --seed 0 \
+        --workers 2 --out results/oracle.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import dataclasses
+import json
+import math
+import multiprocessing as mp
+import os
+import sys
+import time
+from dataclasses import asdict, dataclass, field
+from typing import Any, Sequence
+
+import gymnasium as gym
+import numpy as np
+from tqdm import tqdm
+
+import homing_gym
+from baselines.motion import MotionSpec
+from baselines.planning import NoPathError, path_length, shortest_path
+from homing_gym.geometry import to_frame, wrap_angle
+from train import metrics
+from train.policies import PolicySpec, parse_params, policy_spec
+
+SCHEMA = 1
+DEFAULT_ENV = "homing_gym/LocalHoming-v0"
+
+
+@dataclass
+class EpisodeRecord:
+    """Outcome of one episode (metres, radians unless named otherwise)."""
+
+    seed: int
+    start_pose: list[float]
+    home_pose: list[float]
+    start_distance: float
+    shortest_path: float
+    success: bool
+    terminated: bool
+    truncated: bool
+    steps: int
+    path_length: float
+    final_distance: float
+    min_distance: float
+    collisions: int
+    spl: float
+    soft_spl: float
+    final_heading_error_deg: float
+    wall_time: float
+    trajectory: list[list[float]] = field(default_factory=list, repr=False)
+
+
+@dataclass
+class EvalResult:
+    """A suite's episodes and summary; ``to_dict`` gives the JSON document (schema 1)."""
+
+    policy: str
+    params: dict[str, Any]
+    env_id: str
+    env_kwargs: dict[str, Any]
+    seed: int
+    episodes: list[EpisodeRecord]
+    bin_width: float = 0.3
+    summary: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if not self.summary:
+            self.summary = summarize(self.episodes, self.bin_width, seed=self.seed)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"schema": SCHEMA, "policy": self.policy, "params": self.params,
+                "env_id": self.env_id, "env_kwargs": self.env_kwargs, "seed": self.seed,
+                "homing_gym_version": homing_gym.__version__, "summary": self.summary,
+                "episodes": [asdict(e) for e in self.episodes]}
+
+    def save(self, path: str) -> None:
+        """Write the JSON document to ``path`` and the episode table to ``path`` .csv."""
+        os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+        with open(path, "w") as f:
+            json.dump(self.to_dict(), f, default=_json_default)
+        write_csv(self.episodes, os.path.splitext(path)[0] + ".csv")
+
+    @classmethod
+    def load(cls, path: str) -> "EvalResult":
+        """Read a result JSON; ``ValueError`` naming the file if it is not schema 1."""
+        try:
+            with open(path) as f:
+                doc = json.load(f)
+        except (OSError, json.JSONDecodeError) as err:
+            raise ValueError(f"{path}: not a readable result JSON ({err})") from None
+        if not isinstance(doc, dict) or doc.get("schema") != SCHEMA:
+            raise ValueError(f"{path}: expected a homing-eval result with schema {SCHEMA}, "
+                             f"got schema {doc.get('schema') if isinstance(doc, dict) else None!r}")
+        missing = [k for k in ("policy", "env_id", "seed", "summary", "episodes") if k not in doc]
+        if missing:
+            raise ValueError(f"{path}: result JSON lacks {missing}")
+        names = {f.name for f in dataclasses.fields(EpisodeRecord)}
+        try:
+            episodes = [EpisodeRecord(**{k: v for k, v in e.items() if k in names})
+                        for e in doc["episodes"]]
+        except TypeError as err:
+            raise ValueError(f"{path}: malformed episode record ({err})") from None
+        return cls(policy=doc["policy"], params=doc.get("params", {}), env_id=doc["env_id"],
+                   env_kwargs=doc.get("env_kwargs", {}), seed=doc["seed"], episodes=episodes,
+                   summary=doc["summary"])
+
+
+def _json_default(obj: Any) -> Any:
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    return repr(obj)
+
+
+def write_csv(episodes: Sequence[EpisodeRecord], path: str) -> None:
+    """One row per episode, every field but the trajectory."""
+    names = [f.name for f in dataclasses.fields(EpisodeRecord) if f.name != "trajectory"]
+    with open(path, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=names)
+        writer.writeheader()
+        for e in episodes:
+            row = asdict(e)
+            writer.writerow({k: (json.dumps(row[k]) if isinstance(row[k], list) else row[k])
+                             for k in names})
+
+
+def summarize(episodes: Sequence[EpisodeRecord], bin_width: float = 0.3,
+              seed: int = 0) -> dict[str, Any]:
+    """Means with 95% bootstrap CIs (seeded) and success by start-distance bin."""
+    if not episodes:
+        raise ValueError("no episodes to summarize")
+
+    def col(name: str) -> np.ndarray:
+        return np.array([getattr(e, name) for e in episodes], dtype=np.float64)
+
+    out: dict[str, Any] = {"episodes": len(episodes)}
+    for key, name in (("success_rate", "success"), ("spl", "spl"), ("soft_spl", "soft_spl"),
+                      ("final_distance_mean", "final_distance"),
+                      ("path_length_mean", "path_length"), ("steps_mean", "steps"),
+                      ("collisions_mean", "collisions"), ("min_distance_mean", "min_distance"),
+                      ("heading_error_deg_mean", "final_heading_error_deg")):
+        values = col(name)
+        out[key] = float(values.mean())
+        ci_key = "success_ci" if key == "success_rate" else key.removesuffix("_mean") + "_ci"
+        out[ci_key] = list(metrics.bootstrap_ci(values, seed=seed))
+    final_cm = 100 * col("final_distance")
+    out["final_distance_cm_median"] = float(np.median(final_cm))
+    out["heading_error_deg_median"] = float(np.median(col("final_heading_error_deg")))
+    out["collision_free_rate"] = float(np.mean(col("collisions") == 0))
+    out["wall_time_mean"] = float(col("wall_time").mean())
+    out["bin_width"] = bin_width
+    out["success_by_distance"] = [asdict(b) for b in metrics.distance_bins(
+        col("start_distance"), col("success"), bin_width, seed=seed)]
+    return out
+
+
+# -- running episodes ---------------------------------------------------------------------
+def place_robot(env: gym.Env, pose: Sequence[float]) -> dict[str, np.ndarray]:
+    """Move the robot of a freshly reset env to ``pose`` (x, y, yaw) and return the
+    observation there, as if the episode had started at ``pose``.
+
+    A local stand-in for a public "reset to this start pose" hook of the env (it touches
+    the env's internals the same way ``HomingEnv.reset`` does).
+    """
+    u = env.unwrapped
+    u.sim.robot.set_pose(float(pose[0]), float(pose[1]), float(pose[2]))
+    u.pose = u.sim.robot.pose()
+    u.odometry.reset(to_frame(u.episode.home, u.pose), u.sim.robot.wheel_angles())
+    u._panorama = u.render_panorama(u.pose)
+    u.trajectory = [(float(u.pose[0]), float(u.pose[1]))]
+    u.collisions = 0
+    u.episode = dataclasses.replace(u.episode, start=np.asarray(u.pose, dtype=np.float64).copy())
+    u.task.on_reset(u)
+    return u._observation()
+
+
+def prepare_policy(policy, env: gym.Env) -> None:
+    """Hand the policy what it may know: the command interface; the env itself only to
+    controllers that declare ``needs_env`` (oracles)."""
+    if hasattr(policy, "check_env"):
+        policy.check_env(env)
+    if hasattr(policy, "configure"):
+        policy.configure(MotionSpec.from_env(env))
+    if getattr(policy, "needs_env", False):
+        policy.attach_env(env)
+
+
+def _geodesic(scene, a, b, radius: float) -> float:
+    try:
+        return path_length(shortest_path(scene, a, b, radius))
+    except NoPathError:
+        return math.dist(a[:2], b[:2])
+
+
+def run_episode(env: gym.Env, policy, seed: int,
+                start: Sequence[float] | None = None) -> EpisodeRecord:
+    """Run one episode of ``policy`` (which receives the observation only) and measure it.
+    ``start`` overrides the start pose (used by the homing field)."""
+    t0 = time.perf_counter()
+    obs, info = env.reset(seed=int(seed))
+    if start is not None:
+        obs = place_robot(env, start)
+    u = env.unwrapped
+    home = np.asarray(u.episode.home, dtype=np.float64)
+    start_pose = np.asarray(u.pose, dtype=np.float64).copy()
+    radius = u.robot_config.body_radius
+    if hasattr(policy, "reset"):
+        policy.reset(int(seed))
+    state, episode_start = None, True
+    steps, done, info = 0, False, {"is_success": False, "collisions": 0}
+    terminated = truncated = False
+    while not done:
+        action, state = policy.predict(obs, state=state, episode_start=episode_start,
+                                       deterministic=True)
+        episode_start = False
+        obs, _, terminated, truncated, info = env.step(action)
+        steps += 1
+        done = terminated or truncated
+    traj = np.asarray(u.trajectory, dtype=np.float64)
+    final = np.asarray(u.pose, dtype=np.float64)
+    d_start = float(math.dist(start_pose[:2], home[:2]))
+    shortest = _geodesic(u.scene, start_pose, home, radius)
+    final_geodesic = _geodesic(u.scene, final, home, radius)
+    p = path_length(traj)
+    success = bool(info.get("is_success", False))
+    return EpisodeRecord(
+        seed=int(seed), start_pose=[round(float(v), 4) for v in start_pose],
+        home_pose=[round(float(v), 4) for v in home], start_distance=d_start,
+        shortest_path=shortest, success=success, terminated=bool(terminated),
+        truncated=bool(truncated), steps=steps, path_length=p,
+        final_distance=float(math.dist(final[:2], home[:2])),
+        min_distance=float(np.min(np.hypot(traj[:, 0] - home[0], traj[:, 1] - home[1]))),
+        collisions=int(info.get("collisions", 0)), spl=metrics.spl(success, shortest, p),
+        soft_spl=metrics.soft_spl(final_geodesic, shortest, p),
+        final_heading_error_deg=abs(math.degrees(wrap_angle(final[2] - home[2]))),
+        wall_time=time.perf_counter() - t0,
+        trajectory=np.round(traj, 3).tolist())
+
+
+_WORKER: dict[str, Any] = {}
+
+
+def _init_worker(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any]) -> None:
+    env = gym.make(env_id, **env_kwargs)
+    policy = spec.build()
+    prepare_policy(policy, env)
+    _WORKER.update(env=env, policy=policy)
+
+
+def _work(task: tuple[int, Sequence[float] | None]) -> EpisodeRecord:
+    return run_episode(_WORKER["env"], _WORKER["policy"], *task)
+
+
+def run_episodes(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
+                 tasks: Sequence[tuple[int, Sequence[float] | None]], workers: int = 1,
+                 progress: bool = True, desc: str = "episodes") -> list[EpisodeRecord]:
+    """Run ``tasks`` = [(seed, start pose or None), ...] over ``workers`` processes (spawn
+    context; 1 = in this process). Records come back in task order."""
+    if workers < 1:
+        raise ValueError(f"workers must be >= 1, got {workers}")
+    bar = tqdm(total=len(tasks), desc=desc, disable=not progress, unit="ep")
+    records: list[EpisodeRecord | None] = [None] * len(tasks)
+    try:
+        if workers == 1 or len(tasks) <= 1:
+            _init_worker(spec, env_id, env_kwargs)
+            try:
+                for i, task in enumerate(tasks):
+                    records[i] = _work(task)
+                    bar.update()
+            finally:
+                _WORKER.pop("env").close()
+                _WORKER.clear()
+        else:
+            ctx = mp.get_context("spawn")
+            with ctx.Pool(min(workers, len(tasks)), initializer=_init_worker,
+                          initargs=(spec, env_id, env_kwargs)) as pool:
+                indexed = pool.imap_unordered(_indexed_work, list(enumerate(tasks)))
+                for i, record in indexed:
+                    records[i] = record
+                    bar.update()
+    finally:
+        bar.close()
+    return records  # type: ignore[return-value]
+
+
+def _indexed_work(item: tuple[int, tuple]) -> tuple[int, EpisodeRecord]:
+    return item[0], _work(item[1])
+
+
+def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int = 0,
+             env_kwargs: dict[str, Any] | None = None, workers: int = 1,
+             params: dict[str, Any] | None = None, bin_width: float = 0.3,
+             progress: bool = True) -> EvalResult:
+    """Evaluate ``policy`` (controller name, controller, :class:`PolicySpec` or SB3 zip
+    path) on episodes seeded ``seed .. seed + episodes - 1``."""
+    if episodes < 1:
+        raise ValueError(f"episodes must be >= 1, got {episodes}")
+    if env_id not in gym.registry:
+        raise ValueError(f"unknown env id {env_id!r}; homing-gym ids: {list(homing_gym.ENV_IDS)}")
+    spec = policy_spec(policy, params)
+    env_kwargs = dict(env_kwargs or {})
+    tasks = [(seed + i, None) for i in range(episodes)]
+    records = run_episodes(spec, env_id, env_kwargs, tasks, workers, progress,
+                           desc=f"{spec.label}")
+    return EvalResult(policy=spec.label, params=spec.resolved_params(), env_id=env_id,
+                      env_kwargs=env_kwargs, seed=seed, episodes=records, bin_width=bin_width)
+
+
+# -- command line ---------------------------------------------------------------------------
+def parse_json_kwargs(text: str | None, option: str = "--env-kwargs") -> dict[str, Any]:
+    """Parse a JSON object given on the command line."""
+    if not text:
+        return {}
+    try:
+        value = json.loads(text)
+    except json.JSONDecodeError as err:
+        raise ValueError(f"{option} must be a JSON object, e.g. '{{\"success_on\": \"stop\"}}' "
+                         f"({err})") from None
+    if not isinstance(value, dict):
+        raise ValueError(f"{option} must be a JSON object, got {text!r}")
+    return value
+
+
+def add_policy_arguments(parser: argparse.ArgumentParser) -> None:
+    """The ``--policy/--param/--env/--env-kwargs/--seed/--workers`` options."""
+    parser.add_argument("--policy", required=True,
+                        help="registered controller name or path to a stable-baselines3 .zip")
+    parser.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
+                        help="controller parameter override (repeatable)")
+    parser.add_argument("--env", default=DEFAULT_ENV, help="env id")
+    parser.add_argument("--env-kwargs", default=None, metavar="JSON",
+                        help="keyword arguments of gym.make, a JSON object")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the first episode")
+    parser.add_argument("--workers", type=int, default=1, help="parallel processes")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def policy_from_args(args: argparse.Namespace) -> PolicySpec:
+    params = parse_params(args.param, args.policy) if args.param else {}
+    return policy_spec(args.policy, params)
+
+
+def format_summary(result: EvalResult) -> str:
+    s = result.summary
+    lo, hi = s["success_ci"]
+    return (f"{result.policy} on {result.env_id}: {s['episodes']} episodes, success "
+            f"{100 * s['success_rate']:.1f}% [{100 * lo:.1f}, {100 * hi:.1f}], SPL "
+            f"{s['spl']:.3f}, soft-SPL {s['soft_spl']:.3f}, final distance "
+            f"{100 * s['final_distance_mean']:.1f} cm (median "
+            f"{s['final_distance_cm_median']:.1f}), heading error "
+            f"{s['heading_error_deg_mean']:.1f} deg, collisions/episode "
+            f"{s['collisions_mean']:.2f}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="homing-eval", description=__doc__.split("\n")[0])
+    add_policy_arguments(parser)
+    parser.add_argument("--episodes", type=int, default=100)
+    parser.add_argument("--bin-width", type=float, default=0.3,
+                        help="start-distance bin width (m) for success by distance")
+    parser.add_argument("--out", required=True, help="result JSON path (a .csv goes beside)")
+    args = parser.parse_args(argv)
+    try:
+        spec = policy_from_args(args)
+        result = evaluate(spec, args.env, args.episodes, args.seed,
+                          parse_json_kwargs(args.env_kwargs), args.workers,
+                          bin_width=args.bin_width, progress=not args.quiet)
+    except ValueError as err:
+        parser.exit(2, f"homing-eval: error: {err}\n")
+    result.save(args.out)
+    print(format_summary(result))
+    print(f"wrote {args.out} and {os.path.splitext(args.out)[0]}.csv")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

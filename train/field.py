@@ -1,0 +1,195 @@
+"""The homing vector field (Yu & Kim 2011, Figs. 4 and 10) and its scores.
+
+On a grid over the free floor of the scene of episode ``seed``, the robot is placed with
+a random heading and the controller's first commanded motion direction
+(:attr:`baselines.Controller.last_direction`) is drawn as an arrow. Scores:
+
+* AAE: average angular error (degrees) between the commanded and the true (straight
+  line) home direction;
+* homeward component: mean cosine of that error (1: straight home, 0: chance);
+* return ratio: share of grid starts from which the controller, run to the end of the
+  episode, reaches home (arrow colour: green returned, red did not).
+
+Command line (also ``python -m train.field``)::
+
+    homing-field --policy oracle --env homing_gym/LocalHoming-v0 --grid 0.2 --out field.png
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import cv2
+import gymnasium as gym
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from homing_gym.geometry import wrap_angle  # noqa: E402
+from homing_gym.scenes.base import clearance  # noqa: E402
+from homing_gym.topdown import HOME, MapCanvas, draw_pose, draw_scene  # noqa: E402
+from train.evaluate import (DEFAULT_ENV, add_policy_arguments, parse_json_kwargs,  # noqa: E402
+                            place_robot, policy_from_args, prepare_policy, run_episodes)
+from train.policies import PolicySpec, policy_spec  # noqa: E402
+
+RETURNED, FAILED, UNKNOWN = (40, 160, 60), (210, 50, 40), (40, 90, 200)
+
+
+@dataclass
+class FieldResult:
+    """Grid points (x, y, heading; metres, radians), commanded world directions (radians;
+    NaN where the controller stopped), true home directions, and the scores."""
+
+    policy: str
+    env_id: str
+    seed: int
+    grid: float
+    home: list[float]
+    points: list[list[float]]
+    commanded: list[float]
+    true_direction: list[float]
+    returned: list[bool] | None
+    aae_deg: float
+    homeward: float
+    return_ratio: float | None
+    extra: dict[str, Any] = field(default_factory=dict)
+
+
+def grid_points(scene, home, spacing: float, margin: float, exclude: float) -> np.ndarray:
+    """Cell centres of a ``spacing`` grid over the scene bounds with at least ``margin`` m
+    clearance and more than ``exclude`` m from home."""
+    if not spacing > 0:
+        raise ValueError(f"grid spacing must be positive metres, got {spacing}")
+    (xmin, ymin), (xmax, ymax) = scene.bounds
+    xs = np.arange(xmin + spacing / 2, xmax, spacing)
+    ys = np.arange(ymin + spacing / 2, ymax, spacing)
+    pts = [(x, y) for y in ys for x in xs
+           if clearance(scene, (x, y)) >= margin and math.hypot(x - home[0], y - home[1]) > exclude]
+    return np.array(pts, dtype=np.float64).reshape(-1, 2)
+
+
+def homing_field(policy, env_id: str = DEFAULT_ENV, grid: float = 0.2, seed: int = 0,
+                 env_kwargs: dict[str, Any] | None = None, margin: float = 0.22,
+                 run_to_end: bool = True, workers: int = 1, progress: bool = True,
+                 params: dict[str, Any] | None = None) -> FieldResult:
+    """Compute the vector field of ``policy`` in the scene and home of episode ``seed``."""
+    spec: PolicySpec = policy_spec(policy, params)
+    if spec.kind != "controller":
+        raise ValueError("homing-field needs a scripted controller that reports its commanded "
+                         "direction (Controller.last_direction); SB3 models do not")
+    env_kwargs = dict(env_kwargs or {})
+    env = gym.make(env_id, **env_kwargs)
+    try:
+        env.reset(seed=seed)
+        u = env.unwrapped
+        home = np.asarray(u.episode.home, dtype=np.float64)
+        radius = getattr(u.task, "success_radius", 0.15)
+        xy = grid_points(u.scene, home, grid, margin, radius)
+        if len(xy) == 0:
+            raise ValueError(f"no grid point with {margin} m clearance at spacing {grid} m")
+        headings = np.random.default_rng(seed).uniform(-np.pi, np.pi, len(xy))
+        points = np.column_stack([xy, headings])
+        controller = spec.build()
+        prepare_policy(controller, env)
+        commanded, true_dir = [], []
+        for pose in points:
+            env.reset(seed=seed)
+            obs = place_robot(env, pose)
+            controller.reset(seed)
+            controller.predict(obs, episode_start=True)
+            direction = controller.last_direction
+            commanded.append(math.nan if direction is None else wrap_angle(pose[2] + direction))
+            true_dir.append(math.atan2(home[1] - pose[1], home[0] - pose[0]))
+        scene = u.scene
+    finally:
+        env.close()
+    cmd, true = np.array(commanded), np.array(true_dir)
+    valid = ~np.isnan(cmd)
+    err = np.abs(wrap_angle(cmd[valid] - true[valid])) if valid.any() else np.array([np.pi])
+    returned = None
+    if run_to_end:
+        records = run_episodes(spec, env_id, env_kwargs, [(seed, p) for p in points],
+                               workers, progress, desc=f"{spec.label} field")
+        returned = [r.success for r in records]
+    result = FieldResult(
+        policy=spec.label, env_id=env_id, seed=seed, grid=grid, home=home.tolist(),
+        points=points.round(4).tolist(), commanded=[float(c) for c in cmd],
+        true_direction=true.tolist(), returned=returned,
+        aae_deg=float(np.degrees(err.mean())), homeward=float(np.cos(err).mean()),
+        return_ratio=None if returned is None else float(np.mean(returned)),
+        extra={"stopped_points": int((~valid).sum())})
+    result.extra["scene"] = scene
+    return result
+
+
+def plot_field(result: FieldResult, path: str, size: int = 480) -> None:
+    """Arrows of the commanded directions on the top-down map."""
+    scene = result.extra["scene"]
+    canvas = MapCanvas(scene, size)
+    img = draw_scene(scene, canvas)
+    length = 0.4 * result.grid
+    for k, (x, y, _) in enumerate(result.points):
+        colour = UNKNOWN if result.returned is None else (RETURNED if result.returned[k] else FAILED)
+        c = result.commanded[k]
+        if math.isnan(c):
+            cv2.circle(img, canvas.px(x, y), 3, colour, -1, cv2.LINE_AA)
+            continue
+        tail = canvas.px(x - length / 2 * math.cos(c), y - length / 2 * math.sin(c))
+        tip = canvas.px(x + length / 2 * math.cos(c), y + length / 2 * math.sin(c))
+        cv2.arrowedLine(img, tail, tip, colour, 2, cv2.LINE_AA, tipLength=0.35)
+    draw_pose(img, canvas, result.home, 0.16, HOME, filled=False)
+    fig, ax = plt.subplots(figsize=(5, 5.4), dpi=100)
+    ax.imshow(img)
+    ax.axis("off")
+    title = (f"{result.policy}: AAE {result.aae_deg:.1f} deg, homeward "
+             f"{result.homeward:.2f}")
+    if result.return_ratio is not None:
+        title += f"\nreturn ratio {100 * result.return_ratio:.0f}% (green: returned, red: not)"
+    ax.set_title(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="homing-field", description=__doc__.split("\n")[0])
+    add_policy_arguments(parser)
+    parser.add_argument("--scene", default=None, help="scene name (overrides --env-kwargs)")
+    parser.add_argument("--grid", type=float, default=0.2, help="grid spacing (m)")
+    parser.add_argument("--no-return", action="store_true",
+                        help="skip the return-ratio runs (arrows only, fast)")
+    parser.add_argument("--out", required=True, help="PNG path (scores go to a .json beside)")
+    args = parser.parse_args(argv)
+    try:
+        env_kwargs = parse_json_kwargs(args.env_kwargs)
+        if args.scene:
+            env_kwargs["scene"] = args.scene
+        result = homing_field(policy_from_args(args), args.env, args.grid, args.seed,
+                              env_kwargs, run_to_end=not args.no_return,
+                              workers=args.workers, progress=not args.quiet)
+    except ValueError as err:
+        parser.exit(2, f"homing-field: error: {err}\n")
+    os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
+    plot_field(result, args.out)
+    doc = asdict(result)
+    doc["extra"] = {k: v for k, v in result.extra.items() if k != "scene"}
+    doc["env_kwargs"] = env_kwargs
+    with open(os.path.splitext(args.out)[0] + ".json", "w") as f:
+        json.dump(doc, f)
+    ratio = "n/a" if result.return_ratio is None else f"{100 * result.return_ratio:.1f}%"
+    print(f"{result.policy}: {len(result.points)} grid points, AAE {result.aae_deg:.1f} deg, "
+          f"homeward component {result.homeward:.3f}, return ratio {ratio}")
+    print(f"wrote {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,160 @@
+"""What the harness evaluates: a registered controller (with parameters) or an SB3 model.
+
+:class:`PolicySpec` is a small picklable description that every worker process turns
+into a live policy with :meth:`PolicySpec.build`; :func:`parse_params` reads the
+``--param key=value`` overrides of the command line.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+
+import baselines
+from baselines import Controller
+
+
+@dataclass
+class PolicySpec:
+    """``kind`` is ``"controller"`` (``source`` = registry name, ``params`` overrides,
+    or a ready ``instance``) or ``"sb3"`` (``source`` = path of a model zip)."""
+
+    kind: str
+    source: str
+    params: dict[str, Any] = field(default_factory=dict)
+    instance: Controller | None = None
+
+    @property
+    def label(self) -> str:
+        """Name used in results and plots."""
+        if self.kind == "sb3":
+            return os.path.splitext(os.path.basename(self.source))[0]
+        return self.source
+
+    def build(self):
+        """A fresh live policy (in the calling process)."""
+        if self.kind == "sb3":
+            return SB3Policy(self.source)
+        if self.instance is not None:
+            return dataclasses.replace(self.instance)
+        return baselines.make(self.source, **self.params)
+
+    def resolved_params(self) -> dict[str, Any]:
+        """All parameter values of a controller (defaults included); the path for SB3."""
+        if self.kind == "sb3":
+            return {"path": os.path.abspath(self.source)}
+        return (self.instance if self.instance is not None else self.build()).params()
+
+
+def policy_spec(policy: str | Controller | PolicySpec,
+                params: dict[str, Any] | None = None) -> PolicySpec:
+    """Interpret ``policy``: a :class:`PolicySpec`, a controller instance, a registered
+    controller name or the path of a stable-baselines3 ``.zip``."""
+    params = dict(params or {})
+    if isinstance(policy, PolicySpec):
+        return policy
+    if isinstance(policy, Controller):
+        if params:
+            raise ValueError("give parameters to the controller instance, not as params")
+        return PolicySpec("controller", policy.name or type(policy).__name__, {}, policy)
+    if not isinstance(policy, str):
+        raise ValueError(f"policy must be a controller name, a controller or a model zip "
+                         f"path, got {policy!r}")
+    if policy in baselines.available():
+        baselines.make(policy, **params)  # validates the parameters now
+        return PolicySpec("controller", policy, params)
+    if policy.endswith(".zip") or os.path.exists(policy):
+        if not os.path.isfile(policy):
+            raise ValueError(f"model file {policy!r} does not exist")
+        if params:
+            raise ValueError("--param applies to scripted controllers, not to SB3 models")
+        return PolicySpec("sb3", policy)
+    raise ValueError(f"unknown policy {policy!r}: not a registered controller "
+                     f"{baselines.available()} nor a stable-baselines3 model .zip file")
+
+
+def _coerce(text: str, default: Any, key: str) -> Any:
+    """Parse ``text`` to the type of the parameter's default value."""
+    try:
+        if isinstance(default, bool):
+            if text.lower() in ("true", "1", "yes"):
+                return True
+            if text.lower() in ("false", "0", "no"):
+                return False
+            raise ValueError
+        if isinstance(default, int):
+            return int(text)
+        if isinstance(default, float):
+            return float(text)
+        if isinstance(default, str):
+            return text
+        return json.loads(text)
+    except ValueError:
+        raise ValueError(f"--param {key}={text!r}: expected a value of type "
+                         f"{type(default).__name__}") from None
+
+
+def parse_params(items: list[str] | None, controller: str) -> dict[str, Any]:
+    """``["key=value", ...]`` -> typed parameter overrides for ``controller``."""
+    if not items:
+        return {}
+    if controller not in baselines.available():
+        raise ValueError("--param applies to registered controllers only "
+                         f"{baselines.available()}")
+    defaults = baselines.parameters(controller)
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise ValueError(f"malformed --param {item!r}: expected key=value")
+        if key not in defaults:
+            raise ValueError(f"controller {controller!r} has no parameter {key!r}; "
+                             f"parameters: {sorted(defaults)}")
+        out[key] = _coerce(value.strip(), defaults[key], key)
+    return out
+
+
+def _spaces_match(model_space, env_space) -> bool:
+    """Equal spaces, allowing the channel-first images SB3 stores for HWC image inputs."""
+    if isinstance(model_space, spaces.Dict) and isinstance(env_space, spaces.Dict):
+        return (set(model_space.spaces) == set(env_space.spaces)
+                and all(_spaces_match(model_space[k], env_space[k]) for k in env_space.spaces))
+    if isinstance(model_space, spaces.Box) and isinstance(env_space, spaces.Box):
+        shape = env_space.shape
+        transposed = (shape[-1], *shape[:-1]) if len(shape) == 3 else shape
+        return model_space.dtype == env_space.dtype and model_space.shape in (shape, transposed)
+    return model_space == env_space
+
+
+class SB3Policy:
+    """A stable-baselines3 PPO model behind the harness' policy interface."""
+
+    def __init__(self, path: str):
+        from stable_baselines3 import PPO  # heavy import: only when a model is evaluated
+
+        self.path = path
+        self.model = PPO.load(path, device="cpu")
+
+    def check_env(self, env) -> None:
+        """``ValueError`` if the model was trained on other observation or action spaces."""
+        for what in ("observation_space", "action_space"):
+            mine, theirs = getattr(self.model, what), getattr(env, what)
+            if not _spaces_match(mine, theirs):
+                raise ValueError(f"model {self.path!r} expects {what} {mine}, the env has "
+                                 f"{theirs}; pass matching --env-kwargs (obs_keys, "
+                                 f"action_type, panorama_shape)")
+
+    def reset(self, seed: int | None = None) -> None:
+        """SB3 policies keep no episode memory outside ``state``."""
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+        start = None if episode_start is None else np.atleast_1d(episode_start)
+        return self.model.predict(observation, state=state, episode_start=start,
+                                  deterministic=deterministic)
