@@ -1,0 +1,121 @@
+"""Franz et al. 1998 warping: geometry, search on synthetic and rendered 1-D images."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from baselines.warping import (WarpingConfig, WarpingController, warp_bearings, warp_search,
+                               warping_homing)
+from homing_gym.geometry import wrap_angle
+from homing_gym.panorama import column_bearing
+
+
+def test_warp_bearings_match_exact_geometry_on_the_landmark_circle():
+    rng = np.random.default_rng(0)
+    theta = rng.uniform(-np.pi, np.pi, 50)  # landmarks on the unit circle about home
+    for alpha, rho, psi in ((0.3, 0.5, 0.0), (-2.0, 0.8, 1.2), (1.0, 0.0, -0.4)):
+        pos = np.array([rho * math.cos(alpha), rho * math.sin(alpha)])
+        seen = np.arctan2(np.sin(theta) - pos[1], np.cos(theta) - pos[0]) - psi
+        np.testing.assert_allclose(wrap_angle(warp_bearings(seen, alpha, rho, psi) - theta),
+                                   0, atol=1e-9)
+    with pytest.raises(ValueError):
+        warp_bearings(0.0, 0.0, 1.0)
+
+
+def _image(theta_landmarks, width=256, sigma=0.08):
+    phi = column_bearing(np.arange(width) + 0.5, width)
+    d = wrap_angle(phi[:, None] - np.asarray(theta_landmarks)[None, :])
+    return 1 - np.exp(-0.5 * (d / sigma) ** 2).max(1)
+
+
+def test_search_recovers_a_synthetic_displacement():
+    theta = np.radians([10, 70, 150, 200, 260, 320])
+    alpha, rho, psi = 2.0, 0.3, 0.7
+    pos = rho * np.array([math.cos(alpha), math.sin(alpha)])
+    seen = np.arctan2(np.sin(theta) - pos[1], np.cos(theta) - pos[0]) - psi
+    result = warp_search(_image(seen), _image(theta), WarpingConfig(smooth_deg=0))
+    assert abs(wrap_angle(result.alpha - alpha)) < math.radians(6)
+    assert abs(wrap_angle(result.psi - psi)) < math.radians(2)
+    assert result.rho == pytest.approx(rho, abs=0.051)
+    assert abs(wrap_angle(result.home_direction - (alpha + math.pi - psi))) < math.radians(6)
+    with pytest.raises(ValueError):
+        warp_search(np.zeros(10), np.zeros(12))
+
+
+@pytest.fixture(scope="module")
+def arena():
+    gym = pytest.importorskip("gymnasium")
+    import homing_gym  # noqa: F401
+
+    env = gym.make("homing_gym/LocalHoming-v0", obs_keys=("panorama", "goal"))
+    env.reset(seed=0)
+    yield env
+    env.close()
+
+
+def free_start(env, home, distance, angle, heading, margin=0.25):
+    """The first start ``distance`` m from ``home`` at ``angle`` or counter-clockwise
+    beyond it (0.1 rad steps) with ``margin`` m of clearance: a valid start pose."""
+    from homing_gym.scenes.base import clearance
+
+    for k in range(63):
+        a = angle + 0.1 * k
+        xy = (home[0] + distance * math.cos(a), home[1] + distance * math.sin(a))
+        if clearance(env.unwrapped.scene, xy) >= margin:
+            return (*xy, heading)
+    raise AssertionError("no free start")
+
+
+def _render(env, pose):
+    u = env.unwrapped
+    u.sim.robot.set_pose(*pose)
+    return u.render_panorama(np.asarray(pose, dtype=np.float64))
+
+
+def test_rendered_rotation_is_found_without_displacement(arena):
+    home = (0.05, -0.1, 0.4)
+    _, psi, result = warping_homing(_render(arena, (0.05, -0.1, 1.3)), _render(arena, home))
+    assert result.rho == 0.0
+    assert abs(wrap_angle(psi - 0.9)) < math.radians(2)
+
+
+def test_rendered_pairs_03m_apart_point_home(arena):
+    home = np.array([0.05, -0.1, 0.4])
+    goal = _render(arena, home)
+    errors = []
+    for k in range(8):
+        a = k * math.pi / 4
+        pose = (home[0] + 0.3 * math.cos(a), home[1] + 0.3 * math.sin(a), 0.5 - 0.7 * k)
+        direction, _, _ = warping_homing(_render(arena, pose), goal)
+        truth = math.atan2(home[1] - pose[1], home[0] - pose[0]) - pose[2]
+        errors.append(abs(math.degrees(wrap_angle(direction - truth))))
+    assert max(errors) < 30, errors
+
+
+def test_controller_reaches_home_from_05m(arena):
+    from baselines.motion import MotionSpec
+
+    controller = WarpingController()
+    controller.configure(MotionSpec.from_env(arena))
+    home = (0.05, -0.1, 0.4)
+    for k in range(2):
+        start = free_start(arena, home, 0.5, 1.0 + k * math.pi, 2.0 * k - 1)
+        obs, info = arena.reset(seed=0, options={"home": home, "start": start})
+        controller.reset(0)
+        done, first = False, True
+        while not done:
+            action, _ = controller.predict(obs, episode_start=first)
+            first = False
+            obs, _, terminated, truncated, info = arena.step(action)
+            done = terminated or truncated
+        assert info["is_success"], start
+
+
+def test_bad_parameters_raise():
+    with pytest.raises(ValueError):
+        WarpingConfig(rho_values=(0.0, 1.0))
+    with pytest.raises(ValueError):
+        WarpingController(step_length=0)
