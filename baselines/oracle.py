@@ -3,7 +3,7 @@
 The upper bound of every comparison and a check of the harness: it is the one controller
 that is given the env (``needs_env = True``) and reads ``env.unwrapped.pose``,
 ``episode.home`` and ``scene``. It plans a collision-free shortest path around obstacles
-(:func:`baselines.planning.shortest_path`) once per episode and, at every decision, moves
+(:func:`homing_gym.paths.shortest_path`) once per episode and, at every decision, moves
 at most ``step_length`` metres towards the farthest path waypoint it can see; with
 ``success_on="stop"`` it stops once within ``arrive_tolerance`` of home, after turning to
 the home heading if ``align_heading``.
@@ -17,7 +17,7 @@ from typing import ClassVar
 
 from baselines.base import Controller
 from baselines.motion import Move
-from baselines.planning import NoPathError, segment_free, shortest_path
+from homing_gym.paths import NoPathError, segment_free, shortest_path
 from homing_gym.geometry import bearing_to, wrap_angle
 from homing_gym.scenes.base import clearance
 

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from baselines.planning import segment_free, shortest_path
+from homing_gym.paths import segment_free, shortest_path
 from homing_gym.scenes.arena import arena_scene
 from train.evaluate import EpisodeRecord, summarize
 from train.metrics import bootstrap_ci, distance_bins, path_length, soft_spl, spl

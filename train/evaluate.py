@@ -30,8 +30,8 @@ from tqdm import tqdm
 
 import homing_gym
 from baselines.motion import MotionSpec
-from baselines.planning import NoPathError, path_length, shortest_path
-from homing_gym.geometry import to_frame, wrap_angle
+from homing_gym.paths import NoPathError, path_length, shortest_path
+from homing_gym.geometry import wrap_angle
 from train import metrics
 from train.policies import PolicySpec, parse_params, policy_spec
 
@@ -169,25 +169,6 @@ def summarize(episodes: Sequence[EpisodeRecord], bin_width: float = 0.3,
 
 
 # -- running episodes ---------------------------------------------------------------------
-def place_robot(env: gym.Env, pose: Sequence[float]) -> dict[str, np.ndarray]:
-    """Move the robot of a freshly reset env to ``pose`` (x, y, yaw) and return the
-    observation there, as if the episode had started at ``pose``.
-
-    A local stand-in for a public "reset to this start pose" hook of the env (it touches
-    the env's internals the same way ``HomingEnv.reset`` does).
-    """
-    u = env.unwrapped
-    u.sim.robot.set_pose(float(pose[0]), float(pose[1]), float(pose[2]))
-    u.pose = u.sim.robot.pose()
-    u.odometry.reset(to_frame(u.episode.home, u.pose), u.sim.robot.wheel_angles())
-    u._panorama = u.render_panorama(u.pose)
-    u.trajectory = [(float(u.pose[0]), float(u.pose[1]))]
-    u.collisions = 0
-    u.episode = dataclasses.replace(u.episode, start=np.asarray(u.pose, dtype=np.float64).copy())
-    u.task.on_reset(u)
-    return u._observation()
-
-
 def prepare_policy(policy, env: gym.Env) -> None:
     """Hand the policy what it may know: the command interface; the env itself only to
     controllers that declare ``needs_env`` (oracles)."""
@@ -211,9 +192,8 @@ def run_episode(env: gym.Env, policy, seed: int,
     """Run one episode of ``policy`` (which receives the observation only) and measure it.
     ``start`` overrides the start pose (used by the homing field)."""
     t0 = time.perf_counter()
-    obs, info = env.reset(seed=int(seed))
-    if start is not None:
-        obs = place_robot(env, start)
+    options = None if start is None else {"start": [float(v) for v in start]}
+    obs, info = env.reset(seed=int(seed), options=options)
     u = env.unwrapped
     home = np.asarray(u.episode.home, dtype=np.float64)
     start_pose = np.asarray(u.pose, dtype=np.float64).copy()

@@ -37,7 +37,7 @@ from homing_gym.geometry import wrap_angle  # noqa: E402
 from homing_gym.scenes.base import clearance  # noqa: E402
 from homing_gym.topdown import HOME, MapCanvas, draw_pose, draw_scene  # noqa: E402
 from train.evaluate import (DEFAULT_ENV, add_policy_arguments, parse_json_kwargs,  # noqa: E402
-                            place_robot, policy_from_args, prepare_policy, run_episodes)
+                            policy_from_args, prepare_policy, run_episodes)
 from train.policies import PolicySpec, policy_spec  # noqa: E402
 
 RETURNED, FAILED, UNKNOWN = (40, 160, 60), (210, 50, 40), (40, 90, 200)
@@ -101,8 +101,7 @@ def homing_field(policy, env_id: str = DEFAULT_ENV, grid: float = 0.2, seed: int
         prepare_policy(controller, env)
         commanded, true_dir = [], []
         for pose in points:
-            env.reset(seed=seed)
-            obs = place_robot(env, pose)
+            obs, _ = env.reset(seed=seed, options={"start": [float(v) for v in pose]})
             controller.reset(seed)
             controller.predict(obs, episode_start=True)
             direction = controller.last_direction

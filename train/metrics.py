@@ -4,7 +4,7 @@ Definitions (metres, radians unless named otherwise):
 
 * path length ``p``: sum of the distances between consecutive recorded positions;
 * ``spl`` = ``s * l / max(l, p)`` (Anderson et al. 2018), ``s`` success (0/1), ``l`` the
-  shortest collision-free start-home path length (:func:`baselines.planning.shortest_path`);
+  shortest collision-free start-home path length (:func:`homing_gym.paths.shortest_path`);
 * ``soft_spl`` = ``max(0, 1 - d_T / l) * l / max(l, p)`` (Datta et al. 2021), ``d_T`` the
   shortest-path distance from the final position to home;
 * bootstrap confidence intervals: percentile bootstrap of the mean, seeded.
@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from baselines.planning import path_length
+from homing_gym.paths import path_length
 
 __all__ = ["bootstrap_ci", "distance_bins", "path_length", "soft_spl", "spl"]
 
