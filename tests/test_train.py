@@ -1,0 +1,108 @@
+"""homing-train: smoke runs with both extractors, save/load round trip, --resume."""
+
+import json
+
+import numpy as np
+import pytest
+import torch
+import yaml
+
+from train.extractor import CircularConv, PanoramaGoalExtractor
+from train.train import latest_checkpoint, load_hyperparams, main, make_config, parse_overrides
+
+# 36 rows: the smallest height SB3's NatureCNN (inside CombinedExtractor) accepts
+TINY = ["--env-kwargs", json.dumps({"panorama_shape": [36, 64], "max_episode_steps": 16}),
+        "--n-envs", "1", "--vec", "dummy", "--no-progress",
+        "--hp", "n_steps=64", "--hp", "batch_size=32", "--hp", "n_epochs=1",
+        "--hp", "eval_freq=128", "--hp", "eval_episodes=1", "--hp", "checkpoint_freq=128",
+        "--hp", "features_dim=32"]
+
+
+@pytest.mark.parametrize("extractor", ["panorama", "combined"])
+def test_smoke_run_writes_a_complete_run_folder(tmp_path, extractor):
+    run = tmp_path / extractor
+    main(["--timesteps", "256", "--extractor", extractor, "--out", str(run), *TINY])
+    for name in ("model.zip", "best_model.zip", "evaluations.npz", "config.yml", "command.txt",
+                 "versions.json", "summary.json", "learning_curve.png"):
+        assert (run / name).is_file(), name
+    assert any((run / "tb").iterdir())
+    evaluations = np.load(run / "evaluations.npz")
+    assert list(evaluations["timesteps"]) == [128, 256]
+    assert evaluations["successes"].shape == (2, 1)
+    summary = json.loads((run / "summary.json").read_text())
+    assert summary["timesteps"] == 256 and summary["env_steps_per_s"] > 0
+    config = yaml.safe_load((run / "config.yml").read_text())
+    assert config["extractor"] == extractor and config["ppo"]["n_steps"] == 64
+
+
+def test_save_load_round_trip_gives_identical_actions(tmp_path):
+    import gymnasium as gym
+    from stable_baselines3 import PPO
+
+    run = tmp_path / "run"
+    model = None
+    main(["--timesteps", "128", "--out", str(run), *TINY])
+    model = PPO.load(run / "model.zip")
+    again = PPO.load(run / "model.zip")
+    env = gym.make("homing_gym/LocalHoming-v0", panorama_shape=(36, 64))
+    obs, _ = env.reset(seed=0)
+    for _ in range(5):
+        a, _ = model.predict(obs, deterministic=True)
+        b, _ = again.predict(obs, deterministic=True)
+        assert np.array_equal(a, b)
+        obs, *_ = env.step(a)
+    env.close()
+
+
+def test_resume_continues_the_step_counter(tmp_path):
+    from stable_baselines3 import PPO
+
+    run = tmp_path / "run"
+    main(["--timesteps", "128", "--out", str(run), *TINY])
+    assert latest_checkpoint(run).name == "ppo_128_steps.zip"
+    main(["--resume", str(run), "--timesteps", "256", "--no-progress"])
+    assert PPO.load(run / "model.zip").num_timesteps == 256
+    assert latest_checkpoint(run).name == "ppo_256_steps.zip"
+    summary = json.loads((run / "summary.json").read_text())
+    assert [(s["from_step"], s["to_step"]) for s in summary["sessions"]] == [(0, 128), (128, 256)]
+    assert list(np.load(run / "evaluations.npz")["timesteps"]) == [128, 256]
+
+
+def test_hyperparameters_merge_and_reject_unknown_keys(tmp_path):
+    settings = load_hyperparams("homing_gym/LocalHoming-v0")
+    assert settings["env_kwargs"] == {"scene": "random_arena"} and settings["n_steps"] == 256
+    assert parse_overrides(["n_steps=128", "env_kwargs={scene: arena}"]) == {
+        "n_steps": 128, "env_kwargs": {"scene": "arena"}}
+    with pytest.raises(ValueError, match="learning_rat"):
+        make_config("homing_gym/LocalHoming-v0", {"learning_rat": 1e-3})
+    with pytest.raises(ValueError, match="KEY=VALUE"):
+        parse_overrides(["n_steps"])
+    bad = tmp_path / "bad.yml"
+    bad.write_text("default: [unclosed")
+    with pytest.raises(ValueError, match="bad.yml"):
+        load_hyperparams("homing_gym/LocalHoming-v0", bad)
+
+
+def test_circular_padding_makes_the_extractor_equivariant_to_azimuth_shifts():
+    torch.manual_seed(0)
+    conv = CircularConv(3, 4, kernel=3, stride=1)
+    x = torch.rand(1, 3, 8, 32)
+    shifted = torch.roll(x, 5, dims=3)
+    assert torch.allclose(torch.roll(conv(x), 5, dims=3), conv(shifted), atol=1e-6)
+
+
+def test_extractor_fuses_current_and_goal_early():
+    import gymnasium as gym
+
+    space = gym.spaces.Dict({
+        "panorama": gym.spaces.Box(0, 255, (3, 16, 64), np.uint8),
+        "goal": gym.spaces.Box(0, 255, (3, 16, 64), np.uint8),
+        "odometry": gym.spaces.Box(-np.inf, np.inf, (3,), np.float32)})
+    extractor = PanoramaGoalExtractor(space, features_dim=32)
+    assert extractor.cnn[0].conv.in_channels == 6
+    assert extractor.features_dim == 35
+    out = extractor({"panorama": torch.rand(2, 3, 16, 64), "goal": torch.rand(2, 3, 16, 64),
+                     "odometry": torch.rand(2, 3)})
+    assert out.shape == (2, 35)
+    with pytest.raises(ValueError, match="goal"):
+        PanoramaGoalExtractor(gym.spaces.Dict({"panorama": space["panorama"]}))

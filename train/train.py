@@ -1,0 +1,303 @@
+"""``homing-train``: PPO (stable-baselines3) on any homing-gym env, one folder per run.
+
+    homing-train --env homing_gym/LocalHoming-v0 --seed 0 --timesteps 300000 --out runs/ppo
+    homing-train --resume runs/ppo          # continue from the last checkpoint
+
+Hyperparameters come from ``train/hyperparams/ppo.yml`` (keyed by env id, with a
+``default`` entry), then ``--hyperparams FILE``, then ``--hp KEY=VALUE`` (values parsed as
+YAML), then the dedicated flags. A run folder holds ``model.zip`` (final),
+``best_model.zip`` and ``evaluations.npz`` (``EvalCallback`` on held-out seeds, with
+success rates), ``checkpoints/``, ``config.yml``, ``command.txt``, ``versions.json``,
+``summary.json`` (timesteps, wall time, env steps per second of ``learn()``),
+TensorBoard logs in ``tb/`` and ``learning_curve.png``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import re
+import shlex
+import sys
+import time
+from dataclasses import asdict, dataclass, field, fields
+from functools import partial
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+import yaml
+
+import homing_gym
+from train.extractor import EXTRACTORS, policy_kwargs_for
+
+HYPERPARAMS = Path(str(resources.files("train") / "hyperparams" / "ppo.yml"))
+PPO_KEYS = ("n_steps", "batch_size", "n_epochs", "learning_rate", "gamma", "gae_lambda",
+            "clip_range", "ent_coef", "vf_coef", "max_grad_norm")
+EVAL_SEED_OFFSET = 1_000_000
+
+
+@dataclass
+class TrainConfig:
+    """Everything that defines a run (written to ``config.yml``)."""
+
+    env_id: str
+    seed: int = 0
+    timesteps: int = 300_000
+    n_envs: int = 2
+    vec: str = "subproc"
+    device: str = "cpu"
+    extractor: str = "panorama"
+    features_dim: int = 256
+    env_kwargs: dict = field(default_factory=dict)
+    eval_freq: int = 10_000
+    eval_episodes: int = 20
+    checkpoint_freq: int = 10_000
+    ppo: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.env_id not in homing_gym.ENV_IDS:
+            raise ValueError(f"unknown env {self.env_id!r}; allowed: {list(homing_gym.ENV_IDS)}")
+        if self.vec not in ("subproc", "dummy"):
+            raise ValueError(f"--vec must be 'subproc' or 'dummy', got {self.vec!r}")
+        if self.extractor not in EXTRACTORS:
+            raise ValueError(f"unknown extractor {self.extractor!r}; allowed: {EXTRACTORS}")
+        for key in ("timesteps", "n_envs", "eval_freq", "eval_episodes", "checkpoint_freq"):
+            value = getattr(self, key)
+            if not (isinstance(value, int) and value >= 1):
+                raise ValueError(f"{key} must be an integer >= 1, got {value!r}")
+        unknown = sorted(set(self.ppo) - set(PPO_KEYS))
+        if unknown:
+            raise ValueError(f"unknown PPO hyperparameters {unknown}; allowed: {list(PPO_KEYS)}")
+
+
+def load_hyperparams(env_id: str, path: Path = HYPERPARAMS) -> dict[str, Any]:
+    """The ``default`` entry of a YAML hyperparameter file updated by ``env_id``'s entry."""
+    try:
+        table = yaml.safe_load(Path(path).read_text()) or {}
+    except (OSError, yaml.YAMLError) as err:
+        raise ValueError(f"cannot read hyperparameter file {path}: {err}") from err
+    if not isinstance(table, dict):
+        raise ValueError(f"hyperparameter file {path} must map env ids to settings")
+    merged = dict(table.get("default") or {})
+    merged.update(table.get(env_id) or {})
+    return merged
+
+
+def parse_overrides(items: list[str]) -> dict[str, Any]:
+    """``["n_steps=128", "env_kwargs={scene: arena}"]`` -> values parsed as YAML."""
+    out = {}
+    for item in items:
+        if "=" not in item:
+            raise ValueError(f"--hp expects KEY=VALUE, got {item!r}")
+        key, value = item.split("=", 1)
+        try:
+            out[key.strip()] = yaml.safe_load(value)
+        except yaml.YAMLError as err:
+            raise ValueError(f"--hp {item!r}: the value is not valid YAML ({err})") from err
+    return out
+
+
+def make_config(env_id: str, settings: dict[str, Any], **flags: Any) -> TrainConfig:
+    """Merge hyperparameter settings and command-line flags into a :class:`TrainConfig`."""
+    settings = {**settings, **{k: v for k, v in flags.items() if v is not None}}
+    names = {f.name for f in fields(TrainConfig)} - {"env_id", "ppo"}
+    ppo = {k: settings.pop(k) for k in list(settings) if k in PPO_KEYS}
+    unknown = sorted(set(settings) - names)
+    if unknown:
+        raise ValueError(f"unknown settings {unknown}; allowed: {sorted(names) + list(PPO_KEYS)}")
+    return TrainConfig(env_id=env_id, ppo=ppo, **settings)
+
+
+def make_env(env_id: str, env_kwargs: dict[str, Any]) -> gym.Env:
+    """A single env (top-level, so that subprocess workers can unpickle it)."""
+    import homing_gym  # noqa: F401  (registers the ids in a spawned worker)
+
+    return gym.make(env_id, **env_kwargs)
+
+
+def make_vec(config: TrainConfig, n_envs: int, seed: int):
+    """A monitored vector env of ``n_envs`` copies (success logged from ``is_success``)."""
+    from stable_baselines3.common.env_util import make_vec_env
+    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
+
+    vec_cls, vec_kwargs = DummyVecEnv, None
+    if config.vec == "subproc" and n_envs > 1:
+        vec_cls, vec_kwargs = SubprocVecEnv, {"start_method": "spawn"}
+    return make_vec_env(partial(make_env, config.env_id, config.env_kwargs), n_envs=n_envs,
+                        seed=seed, vec_env_cls=vec_cls, vec_env_kwargs=vec_kwargs,
+                        monitor_kwargs={"info_keywords": ("is_success",)})
+
+
+def versions() -> dict[str, str]:
+    """Versions of the software a run depends on."""
+    import pybullet
+    import stable_baselines3
+    import torch
+
+    return {"python": platform.python_version(), "homing_gym": homing_gym.__version__,
+            "stable_baselines3": stable_baselines3.__version__, "torch": torch.__version__,
+            "gymnasium": gym.__version__, "numpy": np.__version__,
+            "pybullet": str(getattr(pybullet, "__version__", "3.2.x")),
+            "platform": platform.platform()}
+
+
+def latest_checkpoint(run: Path) -> Path | None:
+    """The checkpoint with the most steps in ``run/checkpoints``, if any."""
+    found = [(int(m.group(1)), p) for p in (run / "checkpoints").glob("ppo_*_steps.zip")
+             if (m := re.search(r"ppo_(\d+)_steps", p.name))]
+    return max(found)[1] if found else None
+
+
+def plot_learning_curve(run: Path) -> Path | None:
+    """``learning_curve.png`` from ``evaluations.npz``: mean return and success rate."""
+    data_path = run / "evaluations.npz"
+    if not data_path.is_file():
+        return None
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    data = np.load(data_path)
+    steps = data["timesteps"]
+    fig, ax = plt.subplots(figsize=(6, 3.5), constrained_layout=True)
+    ax.plot(steps, data["results"].mean(axis=1), color="tab:blue", marker="o", ms=3)
+    ax.set_xlabel("environment steps")
+    ax.set_ylabel("mean evaluation return", color="tab:blue")
+    if "successes" in data and data["successes"].size:
+        ax2 = ax.twinx()
+        ax2.plot(steps, 100 * data["successes"].mean(axis=1), color="tab:green", marker="s",
+                 ms=3)
+        ax2.set_ylabel("success rate (%)", color="tab:green")
+        ax2.set_ylim(0, 100)
+    ax.set_title(f"{run.name}: evaluation on held-out seeds")
+    out = run / "learning_curve.png"
+    fig.savefig(out, dpi=100)
+    plt.close(fig)
+    return out
+
+
+def _restore_evaluations(callback, run: Path) -> None:
+    """Let a resumed run's ``EvalCallback`` append to the evaluations already logged."""
+    path = run / "evaluations.npz"
+    if not path.is_file():
+        return
+    data = np.load(path)
+    callback.evaluations_timesteps = list(data["timesteps"])
+    callback.evaluations_results = [list(r) for r in data["results"]]
+    callback.evaluations_length = [list(r) for r in data["ep_lengths"]]
+    callback.evaluations_successes = [list(r) for r in data.get("successes", [])]
+    if len(data["results"]):
+        callback.best_mean_reward = float(np.max(np.mean(data["results"], axis=1)))
+
+
+def train(config: TrainConfig, out: Path, resume: bool = False,
+          command: str | None = None, progress: bool = True):
+    """Train (or, with ``resume``, continue) a run in folder ``out``; returns the model."""
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.callbacks import CheckpointCallback, EvalCallback
+
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "config.yml").write_text(yaml.safe_dump(asdict(config), sort_keys=False))
+    with open(out / "command.txt", "a") as f:
+        f.write((command or shlex.join(sys.argv)) + "\n")
+    (out / "versions.json").write_text(json.dumps(versions(), indent=2))
+    env = make_vec(config, config.n_envs, config.seed)
+    eval_env = make_vec(TrainConfig(**{**asdict(config), "vec": "dummy"}), 1,
+                        config.seed + EVAL_SEED_OFFSET)
+    checkpoint = latest_checkpoint(out) if resume else None
+    try:
+        if checkpoint is not None:
+            model = PPO.load(checkpoint, env=env, device=config.device,
+                             tensorboard_log=str(out / "tb"))
+        else:
+            model = PPO("MultiInputPolicy", env, seed=config.seed, device=config.device,
+                        tensorboard_log=str(out / "tb"), verbose=0,
+                        policy_kwargs=policy_kwargs_for(config.extractor,
+                                                        **({"features_dim": config.features_dim}
+                                                           if config.extractor == "panorama"
+                                                           else {})),
+                        **config.ppo)
+        start_steps = model.num_timesteps
+        remaining = config.timesteps - start_steps
+        eval_cb = EvalCallback(eval_env, n_eval_episodes=config.eval_episodes,
+                               eval_freq=max(config.eval_freq // config.n_envs, 1),
+                               log_path=str(out), best_model_save_path=str(out),
+                               deterministic=True, verbose=0)
+        if checkpoint is not None:
+            _restore_evaluations(eval_cb, out)
+        ckpt_cb = CheckpointCallback(max(config.checkpoint_freq // config.n_envs, 1),
+                                     str(out / "checkpoints"), name_prefix="ppo")
+        t0 = time.perf_counter()
+        if remaining > 0:
+            model.learn(remaining, callback=[eval_cb, ckpt_cb], progress_bar=progress,
+                        reset_num_timesteps=checkpoint is None, tb_log_name="ppo")
+        wall = time.perf_counter() - t0
+        model.save(out / "model.zip")
+        summary_path = out / "summary.json"
+        previous = json.loads(summary_path.read_text()) if summary_path.is_file() else {}
+        sessions = previous.get("sessions", []) + [{
+            "from_step": int(start_steps), "to_step": int(model.num_timesteps),
+            "wall_time_s": round(wall, 1),
+            "env_steps_per_s": round((model.num_timesteps - start_steps) / max(wall, 1e-9), 1)}]
+        total_wall = sum(s["wall_time_s"] for s in sessions)
+        summary_path.write_text(json.dumps({
+            "timesteps": int(model.num_timesteps), "wall_time_s": round(total_wall, 1),
+            "env_steps_per_s": round(sum(s["to_step"] - s["from_step"] for s in sessions)
+                                     / max(total_wall, 1e-9), 1),
+            "sessions": sessions}, indent=2))
+        plot_learning_curve(out)
+    finally:
+        env.close()
+        eval_env.close()
+    return model
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description="train PPO on a homing-gym env")
+    parser.add_argument("--env", default="homing_gym/LocalHoming-v0")
+    parser.add_argument("--out", help="run folder (default runs/<env>_<extractor>_s<seed>)")
+    parser.add_argument("--resume", metavar="RUN", help="continue the run in this folder "
+                        "from its last checkpoint, with its saved config")
+    parser.add_argument("--hyperparams", type=Path, default=HYPERPARAMS,
+                        help="YAML file keyed by env id")
+    parser.add_argument("--hp", action="append", default=[], metavar="KEY=VALUE",
+                        help="override a hyperparameter (YAML value); repeatable")
+    parser.add_argument("--env-kwargs", type=json.loads, help="JSON kwargs of gym.make")
+    parser.add_argument("--seed", type=int)
+    parser.add_argument("--timesteps", type=int)
+    parser.add_argument("--n-envs", type=int)
+    parser.add_argument("--vec", choices=("subproc", "dummy"))
+    parser.add_argument("--device")
+    parser.add_argument("--extractor", choices=EXTRACTORS)
+    parser.add_argument("--no-progress", action="store_true")
+    args = parser.parse_args(argv)
+    try:
+        if args.resume:
+            run = Path(args.resume)
+            if not (run / "config.yml").is_file():
+                raise ValueError(f"--resume {run}: no config.yml there (not a run folder)")
+            saved = yaml.safe_load((run / "config.yml").read_text())
+            if args.timesteps:
+                saved["timesteps"] = args.timesteps
+            config = TrainConfig(**saved)
+        else:
+            settings = load_hyperparams(args.env, args.hyperparams)
+            settings.update(parse_overrides(args.hp))
+            config = make_config(args.env, settings, seed=args.seed, timesteps=args.timesteps,
+                                 n_envs=args.n_envs, vec=args.vec, device=args.device,
+                                 extractor=args.extractor, env_kwargs=args.env_kwargs)
+            run = Path(args.out or f"runs/{config.env_id.split('/')[-1]}_{config.extractor}"
+                                   f"_s{config.seed}")
+    except ValueError as err:
+        parser.error(str(err))
+    train(config, run, resume=bool(args.resume), progress=not args.no_progress)
+    print(f"run folder: {run} ({json.loads((run / 'summary.json').read_text())})")
+
+
+if __name__ == "__main__":
+    main()
