@@ -106,3 +106,16 @@ def test_extractor_fuses_current_and_goal_early():
     assert out.shape == (2, 35)
     with pytest.raises(ValueError, match="goal"):
         PanoramaGoalExtractor(gym.spaces.Dict({"panorama": space["panorama"]}))
+
+
+def test_suite_evaluates_and_compares_methods_on_one_suite(tmp_path, capsys):
+    from train.suite import main as suite_main
+
+    assert suite_main(["--methods", "oracle", "--episodes", "2", "--workers", "1",
+                       "--out", str(tmp_path)]) == 0
+    table = (tmp_path / "table.md").read_text()
+    assert "| oracle |" in table and "table.md" in capsys.readouterr().out
+    for name in ("oracle.json", "oracle.csv", "success_vs_distance.png", "trajectories.png"):
+        assert (tmp_path / name).is_file(), name
+    with pytest.raises(SystemExit):
+        suite_main(["--methods", "telepathy", "--out", str(tmp_path)])

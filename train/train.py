@@ -120,16 +120,18 @@ def make_env(env_id: str, env_kwargs: dict[str, Any]) -> gym.Env:
 
 
 def make_vec(config: TrainConfig, n_envs: int, seed: int):
-    """A monitored vector env of ``n_envs`` copies (success logged from ``is_success``)."""
+    """A monitored vector env of ``n_envs`` copies (success logged from ``is_success``),
+    images transposed to channel-first."""
     from stable_baselines3.common.env_util import make_vec_env
-    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
+    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecTransposeImage
 
     vec_cls, vec_kwargs = DummyVecEnv, None
     if config.vec == "subproc" and n_envs > 1:
         vec_cls, vec_kwargs = SubprocVecEnv, {"start_method": "spawn"}
-    return make_vec_env(partial(make_env, config.env_id, config.env_kwargs), n_envs=n_envs,
-                        seed=seed, vec_env_cls=vec_cls, vec_env_kwargs=vec_kwargs,
-                        monitor_kwargs={"info_keywords": ("is_success",)})
+    env = make_vec_env(partial(make_env, config.env_id, config.env_kwargs), n_envs=n_envs,
+                       seed=seed, vec_env_cls=vec_cls, vec_env_kwargs=vec_kwargs,
+                       monitor_kwargs={"info_keywords": ("is_success",)})
+    return VecTransposeImage(env)      # channel-first images, as SB3 would wrap them itself
 
 
 def versions() -> dict[str, str]:

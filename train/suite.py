@@ -1,0 +1,84 @@
+"""``homing-suite``: the package's main job, the comparison of every method on one suite.
+
+    homing-suite                       # 50 episodes of LocalHoming-v0, seed 0, into results/
+    homing-suite --episodes 200 --workers 2 --out results/full
+
+Evaluates every registered scripted controller (``baselines.available()``) and every
+shipped PPO policy (``train/shipped/*.zip`` with its ``*.yml`` evaluation settings) with the same
+harness on the same seeded episodes (episode ``i`` uses seed ``seed + i``), writes one
+``<method>.json``/``.csv`` per method into ``--out``, then runs ``homing-compare`` on them:
+``table.md`` (printed), ``success_vs_distance.png``, ``final_distance.png`` and
+``trajectories.png``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import yaml
+
+import baselines
+from train.compare import compare
+from train.evaluate import DEFAULT_ENV, evaluate, format_summary
+
+POLICY_DIR = Path(__file__).resolve().parent / "shipped"
+
+
+def shipped_policies(folder: Path = POLICY_DIR) -> dict[str, tuple[Path, dict]]:
+    """Shipped PPO policies: name -> (zip path, env kwargs from the ``.yml`` beside it)."""
+    found = {}
+    for model in sorted(folder.glob("*.zip")):
+        meta_path = model.with_suffix(".yml")
+        meta = yaml.safe_load(meta_path.read_text()) if meta_path.is_file() else {}
+        found[model.stem] = (model, dict(meta.get("eval_env_kwargs") or {}))
+    return found
+
+
+def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 50, seed: int = 0,
+              workers: int = 2, methods: list[str] | None = None) -> dict[str, str]:
+    """Evaluate the methods (default: all controllers and shipped policies) and compare."""
+    out.mkdir(parents=True, exist_ok=True)
+    policies = shipped_policies()
+    candidates = baselines.available() + sorted(policies)
+    chosen = methods or candidates
+    unknown = sorted(set(chosen) - set(candidates))
+    if unknown:
+        raise ValueError(f"unknown methods {unknown}; available: {candidates}")
+    paths = []
+    for name in chosen:
+        policy, kwargs = (str(policies[name][0]), policies[name][1]) if name in policies \
+            else (name, {})
+        result = evaluate(policy, env_id, episodes=episodes, seed=seed, env_kwargs=kwargs,
+                          workers=workers)
+        print(format_summary(result))
+        path = out / f"{name}.json"
+        result.save(str(path))
+        paths.append(str(path))
+    return compare(paths, str(out))
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="homing-suite", description=__doc__.split("\n")[0])
+    parser.add_argument("--env", default=DEFAULT_ENV)
+    parser.add_argument("--episodes", type=int, default=50)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--methods", nargs="+", help="subset of methods (default: all)")
+    parser.add_argument("--out", default="results", help="output folder (default: results)")
+    args = parser.parse_args(argv)
+    if args.episodes < 1 or args.workers < 1:
+        parser.error("--episodes and --workers must be >= 1")
+    try:
+        written = run_suite(Path(args.out), args.env, args.episodes, args.seed, args.workers,
+                            args.methods)
+    except ValueError as err:
+        parser.exit(2, f"homing-suite: error: {err}\n")
+    print(Path(written["table"]).read_text())
+    print("wrote " + ", ".join(written.values()))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
