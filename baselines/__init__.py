@@ -2,7 +2,7 @@
 
 >>> import baselines
 >>> baselines.available()
-['oracle', 'random']
+['distance', 'oracle', 'random', 'warping']
 >>> controller = baselines.make("oracle", step_length=0.2)
 """
 
@@ -13,8 +13,10 @@ from typing import Any
 
 from baselines.base import Controller
 from baselines.motion import MotionHelper, MotionSpec, Move
+from baselines.distance import DistanceController
 from baselines.oracle import OracleController
 from baselines.random_walk import RandomController
+from baselines.warping import WarpingController
 
 _REGISTRY: dict[str, type[Controller]] = {}
 
@@ -57,6 +59,8 @@ def make(name: str, **params: Any) -> Controller:
 
 register("oracle", OracleController)
 register("random", RandomController)
+register("distance", DistanceController)
+register("warping", WarpingController)
 
 __all__ = ["Controller", "MotionHelper", "MotionSpec", "Move", "OracleController",
            "RandomController", "available", "controller_class", "make", "parameters",

@@ -9,8 +9,9 @@ Subclasses implement :meth:`Controller.decide`: from the current observation, re
 next :class:`~baselines.motion.Move` (home vector: direction in the robot frame and step
 length) or ``None`` to stop (arrived). The base class executes each move over several env
 steps with the shared :class:`~baselines.motion.MotionHelper`, asks for the next decision
-once the move is done, and records the commanded direction in :attr:`last_direction`
-(used by the homing vector field).
+once the move is done, and records the commanded direction in :attr:`last_direction` and
+the controller's latest home-direction estimate in :attr:`last_home_direction` (robot
+frame at the time of the decision; used by the homing vector field).
 
 Controllers see the observation only. The harness gives an env handle only to
 controllers that declare ``needs_env = True`` (oracles, named as such), through
@@ -41,6 +42,10 @@ class Controller(ABC):
     name: ClassVar[str] = ""
     #: True only for oracle controllers: the harness then calls :meth:`attach_env`.
     needs_env: ClassVar[bool] = False
+    #: True when every move heads for the controller's home estimate, so the move's
+    #: direction is :attr:`last_home_direction`. Controllers that first probe (distance
+    #: estimation takes a measuring step) set False and set the attribute themselves.
+    moves_home: ClassVar[bool] = True
 
     def __post_init__(self) -> None:
         if self.motion not in MOTION_STYLES:
@@ -51,6 +56,7 @@ class Controller(ABC):
         self._queue: list = []
         self._seed: int | None = None
         self.last_direction: float | None = None
+        self.last_home_direction: float | None = None
         self.last_move: Move | None = None
 
     # -- to override -----------------------------------------------------------------------
@@ -84,6 +90,7 @@ class Controller(ABC):
         self._queue = []
         self._seed = seed
         self.last_direction = None
+        self.last_home_direction = None
         self.last_move = None
         self.on_reset()
 
@@ -99,6 +106,8 @@ class Controller(ABC):
             if move is None:
                 return self._helper.stop_action(), state
             self.last_direction = float(move.direction)
+            if self.moves_home:
+                self.last_home_direction = self.last_direction
             self._queue = self._helper.plan(move)
             if not self._queue:  # a move below the command resolution: stop this step
                 return self._helper.stop_action(), state

@@ -50,7 +50,7 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass, field
-from typing import Sequence
+from typing import ClassVar, Sequence
 
 import numpy as np
 
@@ -437,6 +437,8 @@ class DistanceController(Controller):
     min_axis_deg: float = 10.0
     min_parallax_deg: float = 0.3
 
+    moves_home: ClassVar[bool] = False   # probing steps are not home directions
+
     def validate(self) -> None:
         for key in ("step_length", "move_length", "settle_length", "arrive_tolerance",
                     "nest_step"):
@@ -462,8 +464,6 @@ class DistanceController(Controller):
         self._nest_map: LandmarkMap | None = None
         self.last_estimate: PoseEstimate | None = None
         self.last_diagnostics: Diagnostics | None = None
-        #: The latest homing direction (robot frame, radians); None before the first.
-        self.last_home_direction: float | None = None
 
     def _commanded_step(self) -> float:
         """Forward travel (m) of the actions planned for the step and settle moves."""

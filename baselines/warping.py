@@ -201,7 +201,6 @@ class WarpingController(Controller):
     def on_reset(self) -> None:
         self._goal_image: np.ndarray | None = None
         self.last_result: WarpResult | None = None
-        self.last_home_direction: float | None = None
 
     def decide(self, observation) -> Move | None:
         if self._goal_image is None:
@@ -211,5 +210,4 @@ class WarpingController(Controller):
         self.last_result = result
         if result.rho == 0.0:
             return None
-        self.last_home_direction = result.home_direction
         return Move(result.home_direction, self.step_length)

@@ -31,7 +31,7 @@ DISCRETE_ACTIONS = {0: (1.0, 0.0), 1: (0.0, 1.0), 2: (0.0, -1.0), 3: (0.0, 0.0)}
 DISCRETE_NAMES = ("forward", "turn_left", "turn_right", "stop")
 #: Observation keys the env core provides (tasks may add more).
 OBSERVATION_KEYS = ("panorama", "goal", "omni", "goal_omni", "signature", "goal_signature",
-                    "odometry")
+                    "goal_step", "odometry")
 
 
 class HomingEnv(gym.Env):
@@ -53,7 +53,8 @@ class HomingEnv(gym.Env):
                  action_type: str = "continuous", control_period: float = 0.1,
                  physics_substeps: int = 24, max_speed: float = RobotConfig.max_speed,
                  max_yaw_rate: float = RobotConfig.max_yaw_rate, stop_threshold: float = 0.05,
-                 odometry_noise: float = 0.02, lighting_change: float = 0.0):
+                 odometry_noise: float = 0.02, lighting_change: float = 0.0,
+                 goal_step_length: float = 0.15):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"unknown render_mode {render_mode!r}; allowed: "
                              f"{self.metadata['render_modes']} or None")
@@ -68,6 +69,8 @@ class HomingEnv(gym.Env):
                 raise ValueError(f"{name} must be a positive number, got {value!r}")
         if not (0 <= lighting_change <= 1):
             raise ValueError(f"lighting_change must be in [0, 1] (0: off), got {lighting_change!r}")
+        if not (math.isfinite(goal_step_length) and 0 < goal_step_length <= 1):
+            raise ValueError(f"goal_step_length must be in (0, 1] metres, got {goal_step_length!r}")
         if not (0 <= stop_threshold < 1):
             raise ValueError(f"stop_threshold must be in [0, 1), got {stop_threshold!r}")
         task_keys = task.extra_spaces()
@@ -84,6 +87,7 @@ class HomingEnv(gym.Env):
         self.physics_substeps = int(physics_substeps)
         self.stop_threshold = float(stop_threshold)
         self.lighting_change = float(lighting_change)
+        self.goal_step_length = float(goal_step_length)
         self._lighting: Lighting | None = None
         self.robot_config = RobotConfig(max_speed=float(max_speed),
                                         max_yaw_rate=float(max_yaw_rate))
@@ -105,7 +109,8 @@ class HomingEnv(gym.Env):
         image = spaces.Box(0, 255, (H, W, 3), np.uint8)
         ring = spaces.Box(0, 255, (S, S, 3), np.uint8)
         signature = spaces.Box(0.0, 1.0, (W,), np.float32)
-        core = {"panorama": image, "goal": image, "omni": ring, "goal_omni": ring,
+        core = {"panorama": image, "goal": image, "goal_step": image, "omni": ring,
+                "goal_omni": ring,
                 "signature": signature, "goal_signature": signature,
                 "odometry": spaces.Box(-np.inf, np.inf, (3,), np.float32)}
         core.update(task_keys)
@@ -150,10 +155,18 @@ class HomingEnv(gym.Env):
 
     def _snapshot(self, pose: np.ndarray) -> dict[str, np.ndarray]:
         """Goal observations of a snapshot taken with the robot standing at ``pose``
-        (rendered with the scene's snapshot-time lighting)."""
+        (rendered with the scene's snapshot-time lighting); ``goal_step`` is a second
+        snapshot ``goal_step_length`` metres straight ahead of ``pose`` (Yu & Kim §II-A
+        measure their nest map from two snapshots one step apart)."""
         self.sim.robot.set_pose(*pose)
         goal = self.camera.render(self.sim.client, pose)
         views = {"goal": goal}
+        if "goal_step" in self.obs_keys:
+            d = self.goal_step_length
+            ahead = np.array([pose[0] + d * math.cos(pose[2]), pose[1] + d * math.sin(pose[2]),
+                              pose[2]])
+            self.sim.robot.set_pose(*ahead)
+            views["goal_step"] = self.camera.render(self.sim.client, ahead)
         if "goal_omni" in self.obs_keys:
             views["goal_omni"] = self.camera.omni(goal)
         if "goal_signature" in self.obs_keys:

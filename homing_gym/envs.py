@@ -38,6 +38,7 @@ class LocalHomingEnv(HomingEnv):
     |---|---|---|
     | `panorama` | `Box(0, 255, (H, W, 3), uint8)` | current cylindrical panorama, default 48 x 256 (1.41 deg/column, 1.25 deg/row) |
     | `goal` | same | panorama taken at the home pose |
+    | `goal_step` | same | panorama taken `goal_step_length` (0.15 m) straight ahead of home: a second nest snapshot (Yu & Kim §II-A) |
     | `omni`, `goal_omni` | `Box(0, 255, (S, S, 3), uint8)` | catadioptric ring images, default S = 128 |
     | `signature`, `goal_signature` | `Box(0, 1, (W,), float32)` | Hong 1991 horizon signatures |
     | `odometry` | `Box(-inf, inf, (3,), float32)` | wheel-encoder path integration: pose (x, y, yaw) in the home frame |
@@ -87,7 +88,8 @@ class LocalHomingEnv(HomingEnv):
     ``"human"``: PyBullet GUI), ``obs_keys``, ``panorama_shape`` = (48, 256),
     ``vfov_deg`` = 60, ``n_views`` = 6, ``renderer`` (``"tiny"`` or ``"egl"``), ``omni_size`` = 128,
     ``action_type``, ``control_period``, ``physics_substeps``, ``max_speed``,
-    ``max_yaw_rate``, ``stop_threshold``, ``odometry_noise`` = 0.02, ``lighting_change`` = 0
+    ``max_yaw_rate``, ``stop_threshold``, ``odometry_noise`` = 0.02, ``goal_step_length`` = 0.15,
+    ``lighting_change`` = 0
     (0-1: strength of an illumination change between the home snapshot and the run, drawn
     from the seed: light direction, brightness, contrast),
     ``start_distance``, ``success_radius``, ``success_on``, ``reward`` (a

@@ -131,3 +131,14 @@ def test_reset_options_place_home_and_start(make_env):
         env.reset(seed=0, options={"start": (5.0, 0.0, 0.0)})
     with pytest.raises(ValueError, match="teleport"):
         env.reset(seed=0, options={"teleport": True})
+
+
+def test_goal_step_is_a_second_snapshot_one_step_ahead_of_home(make_env):
+    env = make_env(obs_keys=("panorama", "goal", "goal_step"), goal_step_length=0.2)
+    obs, info = env.reset(seed=2)
+    home = info["goal_pose"]
+    ahead = home + np.array([0.2 * np.cos(home[2]), 0.2 * np.sin(home[2]), 0.0])
+    u = env.unwrapped
+    u.sim.robot.set_pose(*ahead)
+    assert np.array_equal(u.render_panorama(u.sim.robot.pose()), obs["goal_step"])
+    assert not np.array_equal(obs["goal"], obs["goal_step"])

@@ -2,7 +2,8 @@
 
 On a grid over the free floor of the scene of episode ``seed``, the robot is placed with
 a random heading and the controller's first commanded motion direction
-(:attr:`baselines.Controller.last_direction`) is drawn as an arrow. Scores:
+(:attr:`baselines.Controller.last_home_direction`, after a measuring step for methods
+that take one) is drawn as an arrow. Scores:
 
 * AAE: average angular error (degrees) between the commanded and the true (straight
   line) home direction;
@@ -76,6 +77,30 @@ def grid_points(scene, home, spacing: float, margin: float, exclude: float) -> n
     return np.array(pts, dtype=np.float64).reshape(-1, 2)
 
 
+PROBE_STEPS = 40
+
+
+def first_home_decision(env: gym.Env, controller, pose, seed: int,
+                        max_steps: int = PROBE_STEPS) -> tuple[np.ndarray, float | None]:
+    """Start an episode at ``pose`` and run the controller until it states a home
+    direction (at once for most methods; after its measuring step for distance estimation,
+    as in Yu & Kim Fig. 10). Returns the robot pose at that decision and the direction
+    (robot frame, radians), or ``None`` if none came within ``max_steps`` steps."""
+    obs, _ = env.reset(seed=seed, options={"start": [float(v) for v in pose]})
+    controller.reset(seed)
+    episode_start = True
+    for _ in range(max_steps):
+        at = np.asarray(env.unwrapped.pose, dtype=np.float64).copy()
+        action, _ = controller.predict(obs, episode_start=episode_start)
+        episode_start = False
+        if controller.last_home_direction is not None:
+            return at, controller.last_home_direction
+        obs, _, terminated, truncated, _ = env.step(action)
+        if terminated or truncated:
+            break
+    return np.asarray(pose, dtype=np.float64), None
+
+
 def homing_field(policy, env_id: str = DEFAULT_ENV, grid: float = 0.2, seed: int = 0,
                  env_kwargs: dict[str, Any] | None = None, margin: float = 0.22,
                  run_to_end: bool = True, workers: int = 1, progress: bool = True,
@@ -83,8 +108,8 @@ def homing_field(policy, env_id: str = DEFAULT_ENV, grid: float = 0.2, seed: int
     """Compute the vector field of ``policy`` in the scene and home of episode ``seed``."""
     spec: PolicySpec = policy_spec(policy, params)
     if spec.kind != "controller":
-        raise ValueError("homing-field needs a scripted controller that reports its commanded "
-                         "direction (Controller.last_direction); SB3 models do not")
+        raise ValueError("homing-field needs a scripted controller that reports its home "
+                         "direction (Controller.last_home_direction); SB3 models do not")
     env_kwargs = dict(env_kwargs or {})
     env = gym.make(env_id, **env_kwargs)
     try:
@@ -101,12 +126,10 @@ def homing_field(policy, env_id: str = DEFAULT_ENV, grid: float = 0.2, seed: int
         prepare_policy(controller, env)
         commanded, true_dir = [], []
         for pose in points:
-            obs, _ = env.reset(seed=seed, options={"start": [float(v) for v in pose]})
-            controller.reset(seed)
-            controller.predict(obs, episode_start=True)
-            direction = controller.last_direction
-            commanded.append(math.nan if direction is None else wrap_angle(pose[2] + direction))
-            true_dir.append(math.atan2(home[1] - pose[1], home[0] - pose[0]))
+            decision_pose, direction = first_home_decision(env, controller, pose, seed)
+            commanded.append(math.nan if direction is None
+                             else wrap_angle(decision_pose[2] + direction))
+            true_dir.append(math.atan2(home[1] - decision_pose[1], home[0] - decision_pose[0]))
         scene = u.scene
     finally:
         env.close()
