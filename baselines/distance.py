@@ -16,7 +16,9 @@ Robotic Homing Navigation", §II):
    ``assignments="cyclic"``; ``"all"`` tries every injective assignment) gives a rigid
    fit of the egocentric map onto the nest map; each landmark then yields one estimate of
    the robot position. The right arrangement is the one whose estimates *converge*: the
-   smallest RMS spread of the per-landmark position estimates (:func:`localize`).
+   smallest RMS spread of the per-landmark position estimates (:func:`localize`); a
+   landmark with a distance in only one of the two maps adds its lateral offset from the
+   bearing seen in the other (:func:`_bearing_terms`).
 4. The pose in the nest frame gives the home direction and distance; step home, repeat.
 
 Degenerate cases of Eq. 1 (:func:`landmark_distances`): a landmark within
@@ -295,7 +297,9 @@ def localize(ego: LandmarkMap, nest: LandmarkMap, mode: str = "cyclic"
         p = p_all[[i for i, _ in used]]
         q = q_all[[j for _, j in used]]
         phi, t, mean = rigid_fit(p, q)
-        spread = float(np.sqrt(np.mean(np.sum((t - mean) ** 2, axis=1))))
+        terms = list(np.sum((t - mean) ** 2, axis=1))
+        terms += _bearing_terms(ego, nest, pairs, phi, mean)
+        spread = float(np.sqrt(np.mean(terms)))
         candidates.append(PoseEstimate(float(mean[0]), float(mean[1]), wrap_angle(phi),
                                        spread, tuple(pairs), len(used)))
     if not candidates:
@@ -303,6 +307,31 @@ def localize(ego: LandmarkMap, nest: LandmarkMap, mode: str = "cyclic"
     most = max(c.n_used for c in candidates)
     best = min((c for c in candidates if c.n_used == most), key=lambda c: c.spread)
     return best, candidates
+
+
+def _bearing_terms(ego: LandmarkMap, nest: LandmarkMap, pairs, phi: float,
+                   t: np.ndarray) -> list[float]:
+    """Squared lateral offsets (m²) of the landmarks of an arrangement that have a distance
+    in one map only: their position from that map, carried over by the candidate pose,
+    must lie on the bearing seen in the other. With two landmarks measured in both maps
+    every arrangement whose two inter-landmark distances agree fits exactly; these
+    bearings are what lets the right one still converge best (§II-B's criterion applied
+    to every landmark of the arrangement)."""
+    c, s = math.cos(phi), math.sin(phi)
+    out = []
+    for i, j in pairs:
+        if nest.valid[j] and not ego.valid[i]:
+            v = nest.positions[j] - t  # nest landmark relative to the robot, nest frame
+            rel = np.array([c * v[0] + s * v[1], -s * v[0] + c * v[1]])  # robot frame
+            err = wrap_angle(math.atan2(rel[1], rel[0]) - ego.bearings[i])
+        elif ego.valid[i] and not nest.valid[j]:
+            p = ego.positions[i]
+            rel = np.array([c * p[0] - s * p[1], s * p[0] + c * p[1]]) + t  # nest frame
+            err = wrap_angle(math.atan2(rel[1], rel[0]) - nest.bearings[j])
+        else:
+            continue
+        out.append(float(np.hypot(*rel) * math.sin(min(abs(err), math.pi / 2))) ** 2)
+    return out
 
 
 def resect_nest_map(ego: LandmarkMap, nest_bearings: np.ndarray, mode: str = "cyclic",
@@ -401,6 +430,62 @@ def distance_homing(view0: np.ndarray, view1: np.ndarray, step: float, nest_map:
     return pose, pose.home_direction, diag
 
 
+# -- obstacles (our addition) ---------------------------------------------------------------
+def view_obstacles(arcs: Sequence[Arc], ego: LandmarkMap | None, radius: float
+                   ) -> list[tuple[float, float, float]]:
+    """Landmarks of the current view as discs (x, y, r) in the robot frame (metres).
+    Where Eq. 1 measured the distance R (``ego``), the disc is at R with r = R sin(w/2)
+    from the angular width w; elsewhere the distance follows from the width and
+    ``radius``: R = radius / sin(w/2) (merged arcs look wider, hence nearer: cautious)."""
+    out = []
+    measured = {}
+    if ego is not None:
+        measured = {round(float(b), 9): float(r) for b, r in zip(ego.bearings, ego.distances)
+                    if np.isfinite(r)}
+    for a in arcs:
+        half = min(max(a.width / 2, 1e-3), math.pi / 2)
+        r = measured.get(round(float(a.bearing), 9))
+        if r is not None:
+            rad = r * math.sin(half)
+        else:
+            rad = radius
+            r = radius / math.sin(half)
+        out.append((r * math.cos(a.bearing), r * math.sin(a.bearing), rad))
+    return out
+
+
+def free_direction(direction: float, length: float, obstacles, clearance: float,
+                   resolution: float = math.radians(5)) -> float | None:
+    """The direction nearest ``direction`` (robot frame, radians) along which a straight
+    path of ``length`` m keeps ``clearance`` m between the robot centre and every disc of
+    ``obstacles``; from inside that margin, only directions leading away are free.
+    None if no direction is free."""
+    for k in range(int(math.pi / resolution) + 1):
+        for sign in ((1,) if k == 0 else (1, -1)):
+            d = wrap_angle(direction + sign * k * resolution)
+            u = np.array([math.cos(d), math.sin(d)])
+            if all(_clear(u, length, ob, clearance) for ob in obstacles):
+                return float(d)
+    return None
+
+
+def _clear(u: np.ndarray, length: float, ob, clearance: float) -> bool:
+    c = np.array(ob[:2])
+    need = clearance + ob[2]
+    d0 = float(np.hypot(*c))
+    if d0 < need:
+        return float(u @ c) <= 0.0
+    t = min(max(float(u @ c), 0.0), length)
+    return float(np.hypot(*(c - t * u))) >= need
+
+
+def _blocked(ego: LandmarkMap) -> bool:
+    """True when a measuring step moved no landmark: none measured or out of range, at
+    least one without parallax (the robot pushed against an obstacle)."""
+    return "no parallax" in ego.status and not any(s in ("ok", "out of range")
+                                                     for s in ego.status)
+
+
 # -- the controller --------------------------------------------------------------------------
 NEST_SOURCES = ("auto", "goal_step", "resection")
 #: Angle (radians) between the heading and the landmark group after a failed measurement.
@@ -424,6 +509,15 @@ class DistanceController(Controller):
     ``nest``: where the nest map comes from (module doc): ``"goal_step"`` needs the
     observation key ``goal_step`` taken ``nest_step`` m ahead of the nest; ``"resection"``
     the interim; ``"auto"`` the first if the key is present.
+
+    Obstacles (our addition; the paper's robot drove among the cylinders without saying
+    how it avoided them): every move, the probing step included, is checked against the
+    landmarks of the current view (:func:`view_obstacles`: Eq. 1 distances where measured,
+    else the distance implied by the arc's angular width and the landmark radius). A move
+    whose path passes within ``clearance`` m (robot centre to cylinder surface) of one is
+    turned to the nearest free direction (:func:`free_direction`). A measuring step that
+    did not move the robot (no landmark shifted: it is pushing against something) is
+    followed by a turn-around.
     """
 
     step_length: float = 0.15
@@ -436,12 +530,14 @@ class DistanceController(Controller):
     assignments: str = "cyclic"
     min_axis_deg: float = 10.0
     min_parallax_deg: float = 0.3
+    clearance: float = 0.22
+    landmark_radius: float = 0.1075
 
     moves_home: ClassVar[bool] = False   # probing steps are not home directions
 
     def validate(self) -> None:
         for key in ("step_length", "move_length", "settle_length", "arrive_tolerance",
-                    "nest_step"):
+                    "nest_step", "clearance", "landmark_radius"):
             value = getattr(self, key)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
                 raise ValueError(f"distance: {key} must be a positive number of metres, "
@@ -462,6 +558,8 @@ class DistanceController(Controller):
         self._nest_sum: np.ndarray | None = None
         self._nest_count: np.ndarray | None = None
         self._nest_map: LandmarkMap | None = None
+        self._turned = False
+        self._radii: list[float] = []
         self.last_estimate: PoseEstimate | None = None
         self.last_diagnostics: Diagnostics | None = None
 
@@ -473,7 +571,18 @@ class DistanceController(Controller):
 
     def decide(self, observation) -> Move | None:
         if self._phase == "probe":
-            self._view0 = observation["panorama"]
+            view = observation["panorama"]
+            if not self._turned:
+                # look before stepping: turn on the spot if the step would hit a landmark
+                obstacles = view_obstacles(detect_landmarks(view, self.config.segmentation),
+                                           None, self._radius())
+                probe = self.step_length + self.settle_moves * self.settle_length
+                free = free_direction(0.0, probe, obstacles, self.clearance)
+                if free is None or abs(free) > 1e-6:
+                    self._turned = True
+                    return Move(math.pi if free is None else free, 0.0)
+            self._turned = False
+            self._view0 = view
             self._travel = [Move(0.0, self.step_length)]
             self._phase = "settle"
             return self._travel[0]
@@ -483,31 +592,60 @@ class DistanceController(Controller):
             return move
         self._phase = "probe"
         step = self._commanded_step()
-        nest_map = self._nest(observation, self._view0, observation["panorama"], step)
+        view = observation["panorama"]
+        seg = self.config.segmentation
+        arcs1 = detect_landmarks(view, seg)
+        ego = landmark_distances(detect_landmarks(self._view0, seg), arcs1, step, 0.0,
+                                 self.config)
+        self._learn_radii(ego)
+        obstacles = view_obstacles(arcs1, ego, self._radius())
+        if _blocked(ego):
+            # the step did not move the robot: back away from whatever it pushes against
+            return self._safe(math.pi, self.move_length / 2, obstacles)
+        nest_map = self._nest(observation, self._view0, view, step)
         if nest_map is None:
-            return self._fallback(observation["panorama"])
-        pose, direction, diag = distance_homing(self._view0, observation["panorama"], step,
-                                                nest_map, 0.0, self.config)
+            return self._fallback(arcs1, obstacles)
+        pose, direction, diag = distance_homing(self._view0, view, step, nest_map, 0.0,
+                                                self.config)
         self.last_diagnostics, self.last_estimate = diag, pose
         if pose is None:
-            return self._fallback(observation["panorama"])
+            return self._fallback(arcs1, obstacles)
         self.last_home_direction = direction
         if pose.home_distance < self.arrive_tolerance:
             return None
-        return Move(direction, min(self.move_length, pose.home_distance))
+        return self._safe(direction, min(self.move_length, pose.home_distance), obstacles)
 
-    def _fallback(self, view: np.ndarray) -> Move:
+    def _radius(self) -> float:
+        """Landmark radius for width-based distances: the median of this episode's
+        measured radii (R sin(w/2)), else the ``landmark_radius`` prior."""
+        return float(np.median(self._radii)) if self._radii else self.landmark_radius
+
+    def _learn_radii(self, ego: LandmarkMap) -> None:
+        for r, w in zip(ego.distances, ego.widths):
+            if np.isfinite(r) and 0 < w < math.radians(40):
+                self._radii.append(float(r * math.sin(w / 2)))
+
+    def _safe(self, direction: float, length: float, obstacles) -> Move:
+        """``Move(direction, length)`` turned to the nearest direction whose path (and the
+        next measuring step) keeps ``clearance`` from every seen landmark."""
+        reach = length + self.step_length + self.settle_moves * self.settle_length
+        free = free_direction(direction, reach, obstacles, self.clearance)
+        if free is None:
+            return Move(wrap_angle(direction + math.pi), 0.0)
+        return Move(wrap_angle(free), length)
+
+    def _fallback(self, arcs: Sequence[Arc], obstacles) -> Move:
         """Too few measurable landmarks (seen from the periphery they crowd into a narrow
         sector, merge or sit on the line of motion): turn so that the landmark group lies
-        ``FALLBACK_OFFSET`` off the heading and walk one ``move_length`` that way, so the
-        next measurement is closer to the landmarks and off their axis (our addition; the
-        paper leaves such places without a decision, Fig. 10)."""
-        arcs = detect_landmarks(view, self.config.segmentation)
+        ``FALLBACK_OFFSET`` off the heading and walk one ``move_length`` that way (kept
+        clear of the landmarks), so the next measurement is closer to the landmarks and
+        off their axis (our addition; the paper leaves such places without a decision,
+        Fig. 10)."""
         if not arcs:
-            return Move(FALLBACK_OFFSET, self.move_length)
+            return self._safe(FALLBACK_OFFSET, self.move_length, obstacles)
         mean = math.atan2(sum(math.sin(a.bearing) for a in arcs),
                           sum(math.cos(a.bearing) for a in arcs))
-        return Move(wrap_angle(mean + FALLBACK_OFFSET), self.move_length)
+        return self._safe(wrap_angle(mean + FALLBACK_OFFSET), self.move_length, obstacles)
 
     def _nest(self, observation, view0, view1, step: float) -> LandmarkMap | None:
         """The nest map: measured from ``goal_step`` (paper) or the resection interim."""

@@ -187,12 +187,14 @@ def _geodesic(scene, a, b, radius: float) -> float:
         return math.dist(a[:2], b[:2])
 
 
-def run_episode(env: gym.Env, policy, seed: int,
-                start: Sequence[float] | None = None) -> EpisodeRecord:
+def run_episode(env: gym.Env, policy, seed: int, start: Sequence[float] | None = None,
+                home: Sequence[float] | None = None) -> EpisodeRecord:
     """Run one episode of ``policy`` (which receives the observation only) and measure it.
-    ``start`` overrides the start pose (used by the homing field)."""
+    ``start`` and ``home`` override the start and home poses (x, y, yaw): the homing
+    field sets the start, a fixed-nest evaluation (Yu & Kim Fig. 6) both."""
     t0 = time.perf_counter()
-    options = None if start is None else {"start": [float(v) for v in start]}
+    options = {key: [float(v) for v in pose] for key, pose in (("start", start), ("home", home))
+               if pose is not None} or None
     obs, info = env.reset(seed=int(seed), options=options)
     u = env.unwrapped
     home = np.asarray(u.episode.home, dtype=np.float64)
@@ -241,15 +243,19 @@ def _init_worker(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any]) -> N
     _WORKER.update(env=env, policy=policy)
 
 
-def _work(task: tuple[int, Sequence[float] | None]) -> EpisodeRecord:
+def _work(task: tuple) -> EpisodeRecord:
     return run_episode(_WORKER["env"], _WORKER["policy"], *task)
 
 
 def run_episodes(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
-                 tasks: Sequence[tuple[int, Sequence[float] | None]], workers: int = 1,
+                 tasks: Sequence[tuple], workers: int = 1,
                  progress: bool = True, desc: str = "episodes") -> list[EpisodeRecord]:
-    """Run ``tasks`` = [(seed, start pose or None), ...] over ``workers`` processes (spawn
-    context; 1 = in this process). Records come back in task order."""
+    """Run ``tasks`` = [(seed, start pose or None[, home pose or None]), ...] over
+    ``workers`` processes (spawn context; 1 = in this process). Records come back in task
+    order."""
+    for task in tasks:
+        if not 1 <= len(task) <= 3:
+            raise ValueError(f"a task is (seed, start, home), got {task!r}")
     if workers < 1:
         raise ValueError(f"workers must be >= 1, got {workers}")
     bar = tqdm(total=len(tasks), desc=desc, disable=not progress, unit="ep")

@@ -14,9 +14,12 @@ warping (``warping``, :mod:`baselines.warping`), both without a compass.
   intervals, ``--samples`` random poses) and ``distance_error.png`` (Eq. 1 error of
   every measured landmark over the grid: median and 90th percentile, %).
 * ``success``: Fig. 6, success rate of ``--trials`` closed-loop LocalHoming-v0 episodes
-  per start-distance bin (random home and start, through :func:`train.evaluate.evaluate`)
-  for both controllers: ``fig6_success.png``.
-* ``eval``: the 200-episode LocalHoming-v0 suite of a controller (as ``homing-eval``).
+  per start-distance bin to a fixed nest at the arena centre (``HOME_POSE``; starts
+  uniform in each bin, random headings; ``FIG6_STEPS`` steps at most), the same tasks for
+  both controllers (:func:`fig6_tasks`, :func:`train.evaluate.run_episodes` with a home
+  pose per task): ``fig6_success.png`` and ``success.json`` (Wilson 95% intervals).
+* ``eval``: the 200-episode LocalHoming-v0 suite of a controller (as ``homing-eval``;
+  ``distance`` gets the ``goal_step`` observation, the paper's second nest snapshot).
 
 Command line::
 
@@ -75,6 +78,16 @@ def t_quantile(p: float, dof: int) -> float:
     pdf = np.exp(logc - (dof + 1) / 2 * np.log1p(x ** 2 / dof))
     cdf = 0.5 + np.concatenate([[0], np.cumsum((pdf[1:] + pdf[:-1]) / 2 * np.diff(x))])
     return float(np.interp(p, cdf, x))
+
+
+def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
+    """95% Wilson score interval of a success proportion k / n."""
+    if n == 0:
+        return math.nan, math.nan
+    p = k / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return max(0.0, centre - half), min(1.0, centre + half)
 
 
 def mean_ci(values: np.ndarray) -> tuple[float, float]:
@@ -295,20 +308,58 @@ def plot_distance_error(rel: np.ndarray, path: str) -> dict:
     return stats
 
 
-def run_success(out: str, trials: int, workers: int, seed: int,
-                bins=((0.3, 0.6), (0.6, 0.9), (0.9, 1.2), (1.2, 1.5))) -> dict:
-    from train.evaluate import evaluate
+FIG6_BINS = ((0.3, 0.6), (0.6, 0.9), (0.9, 1.2), (1.2, 1.4))
+FIG6_STEPS = 300  # 30 s: about twice what distance estimation needs from 1.4 m
 
+
+def fig6_tasks(trials: int, seed: int, bins=FIG6_BINS) -> list[list[tuple]]:
+    """Per bin, ``trials`` tasks (seed, start, home): the nest fixed at ``HOME_POSE`` (as
+    the paper's nest), starts at a distance uniform in the bin, uniform direction, random
+    heading (§III: "an arbitrary position with random direction of heading"), with the
+    env's start clearance."""
+    env = gym.make(ENV_ID)
+    try:
+        env.reset(seed=0, options={"home": HOME_POSE})
+        scene = env.unwrapped.scene
+    finally:
+        env.close()
+    rng = np.random.default_rng(seed)
+    out = []
+    for b, (lo, hi) in enumerate(bins):
+        tasks = []
+        while len(tasks) < trials:
+            d, a = rng.uniform(lo, hi), rng.uniform(-np.pi, np.pi)
+            xy = (HOME_POSE[0] + d * math.cos(a), HOME_POSE[1] + d * math.sin(a))
+            if clearance(scene, xy) >= MARGIN:
+                start = (xy[0], xy[1], float(rng.uniform(-np.pi, np.pi)))
+                tasks.append((seed + 1000 * b + len(tasks), start, HOME_POSE))
+        out.append(tasks)
+    return out
+
+
+def run_success(out: str, trials: int, workers: int, seed: int, bins=FIG6_BINS,
+                max_steps: int = FIG6_STEPS) -> dict:
+    """Fig. 6: ``trials`` episodes per start-distance bin to the fixed nest, both methods
+    on the same tasks (``distance`` with the ``goal_step`` nest snapshot)."""
+    from train.evaluate import run_episodes
+    from train.policies import policy_spec
+
+    kwargs = {"obs_keys": ["panorama", "goal", "goal_step"], "max_episode_steps": max_steps}
+    tasks = fig6_tasks(trials, seed, bins)
     results = {}
-    for name, cls in CONTROLLERS.items():
+    for name in CONTROLLERS:
         rows = []
-        for lo, hi in bins:
-            r = evaluate(cls(), ENV_ID, trials, seed, {"start_distance": [lo, hi]}, workers,
-                         progress=True)
-            s = r.summary
-            rows.append({"lo": lo, "hi": hi, "success_rate": s["success_rate"],
-                         "success_ci": s["success_ci"], "spl": s["spl"]})
-            print(f"{name} [{lo}, {hi}) m: success {100 * s['success_rate']:.0f}%")
+        for (lo, hi), bin_tasks in zip(bins, tasks):
+            recs = run_episodes(policy_spec(name), ENV_ID, kwargs, bin_tasks, workers,
+                                desc=f"{name} [{lo}, {hi}) m")
+            ok = np.array([r.success for r in recs], float)
+            k, n = int(ok.sum()), len(ok)
+            rows.append({"lo": lo, "hi": hi, "trials": n, "successes": k,
+                         "success_rate": k / n, "success_ci": list(wilson(k, n)),
+                         "collisions_mean": float(np.mean([r.collisions for r in recs])),
+                         "final_distance_mean": float(np.mean([r.final_distance for r in recs])),
+                         "steps_mean": float(np.mean([r.steps for r in recs]))})
+            print(f"{name} [{lo}, {hi}) m: success {k}/{n}", flush=True)
         results[name] = rows
     fig, ax = plt.subplots(figsize=(5.5, 4), dpi=100)
     for (name, rows), colour in zip(results.items(), ("C0", "C3")):
@@ -318,11 +369,12 @@ def run_success(out: str, trials: int, workers: int, seed: int,
                          100 * (r["success_ci"][1] - r["success_rate"])] for r in rows]).T
         ax.errorbar(c, y, yerr=err, marker="o", capsize=3, color=colour, label=name)
     ax.set_xlabel("start distance from home (cm)")
-    ax.set_ylabel(f"success rate (%) of {trials} trials")
+    ax.set_ylabel(f"success rate (%) of {trials} trials per bin")
     ax.set_ylim(0, 105)
     ax.grid(alpha=0.3)
     ax.legend()
-    ax.set_title("Fig. 6-like: LocalHoming-v0, arena, no compass", fontsize=10)
+    ax.set_title(f"Fig. 6-like: fixed nest at the arena centre, no compass\n"
+                 f"({max_steps} steps max; 95% Wilson intervals)", fontsize=10)
     fig.tight_layout()
     fig.savefig(os.path.join(out, "fig6_success.png"))
     plt.close(fig)
@@ -346,7 +398,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.what == "eval":
         from train.evaluate import evaluate, format_summary
 
-        result = evaluate(CONTROLLERS[args.policy](), ENV_ID, args.episodes, args.seed,
+        kwargs = ({"obs_keys": ["panorama", "goal", "goal_step"]} if args.policy == "distance"
+                  else {})
+        result = evaluate(args.policy, ENV_ID, args.episodes, args.seed, kwargs,
                           workers=args.workers)
         result.save(args.out)
         print(format_summary(result))
