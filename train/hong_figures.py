@@ -269,6 +269,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--only", nargs="+", default=["sweep", "field", "eval", "route"],
                         choices=["signature", "sweep", "field", "eval", "route"])
     parser.add_argument("--episodes", type=int, default=200)
+    parser.add_argument("--methods", nargs="+", default=None,
+                        help="controllers to run (default: snapshot and warping if registered)")
     parser.add_argument("--tables", action="store_true",
                         help="only print the Markdown tables of an existing results.json")
     parser.add_argument("--routes", type=int, default=20)
@@ -280,7 +282,12 @@ def main(argv: list[str] | None = None) -> int:
     if args.tables:
         print(markdown_tables(results))
         return 0
-    names = methods()
+    register()
+    names = methods() if args.methods is None else args.methods
+    unknown = sorted(set(names) - set(baselines.available()))
+    if unknown:
+        parser.exit(2, f"hong-figures: unknown controllers {unknown}; "
+                       f"available: {baselines.available()}\n")
     print(f"methods: {names}")
     steps = {"signature": lambda: plot_signature(args.out), "sweep": lambda: run_sweep(), "field": lambda: run_fields(args.out, names),
              "eval": lambda: run_eval(names, args.episodes),
