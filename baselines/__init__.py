@@ -2,7 +2,7 @@
 
 >>> import baselines
 >>> baselines.available()
-['distance', 'oracle', 'random', 'warping']
+['distance', 'oracle', 'random', 'snapshot', 'warping']
 >>> controller = baselines.make("oracle", step_length=0.2)
 """
 
@@ -16,6 +16,7 @@ from baselines.motion import MotionHelper, MotionSpec, Move
 from baselines.distance import DistanceController
 from baselines.oracle import OracleController
 from baselines.random_walk import RandomController
+from baselines.snapshot import SnapshotController
 from baselines.warping import WarpingController
 
 _REGISTRY: dict[str, type[Controller]] = {}
@@ -61,6 +62,7 @@ register("oracle", OracleController)
 register("random", RandomController)
 register("distance", DistanceController)
 register("warping", WarpingController)
+register("snapshot", SnapshotController)
 
 __all__ = ["Controller", "MotionHelper", "MotionSpec", "Move", "OracleController",
            "RandomController", "available", "controller_class", "make", "parameters",

@@ -483,11 +483,3 @@ class SnapshotController(Controller):
         turn = float(integrate(self._helper.plan(move), self._helper.spec)[2])
         self._psi = wrap_angle(est.deviation + turn)
         return move
-
-
-def register() -> None:
-    """Register ``SnapshotController`` as ``snapshot`` unless it already is."""
-    import baselines
-
-    if "snapshot" not in baselines.available():
-        baselines.register("snapshot", SnapshotController)

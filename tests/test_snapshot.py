@@ -12,8 +12,7 @@ import baselines
 from baselines.motion import MotionSpec
 from baselines.signature import (bearing_grid, characteristic_points, monotonic_segments,
                                  signature_from_omni, signature_from_panorama)
-from baselines.snapshot import (HongConfig, SnapshotController, harmonic_weights, hong_homing,
-                                register)
+from baselines.snapshot import HongConfig, SnapshotController, harmonic_weights, hong_homing
 from homing_gym.geometry import wrap_angle
 from train.hong_figures import render_pairs
 
@@ -146,7 +145,6 @@ def test_config_validation():
 
 # -- the controller -------------------------------------------------------------------------
 def test_registered_and_needs_its_observation_keys():
-    register()
     controller = baselines.make("snapshot", k_back=20.0)
     assert isinstance(controller, SnapshotController)
     with pytest.raises(ValueError, match="goal_omni"):
