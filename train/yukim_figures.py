@@ -361,12 +361,21 @@ def run_success(out: str, trials: int, workers: int, seed: int, bins=FIG6_BINS,
                          "steps_mean": float(np.mean([r.steps for r in recs]))})
             print(f"{name} [{lo}, {hi}) m: success {k}/{n}", flush=True)
         results[name] = rows
+    with open(os.path.join(out, "success.json"), "w") as f:  # before plotting
+        json.dump(results, f, indent=1, default=float)
+    plot_success(results, trials, max_steps, os.path.join(out, "fig6_success.png"))
+    return results
+
+
+def plot_success(results: dict, trials: int, max_steps: int, path: str) -> None:
+    """Fig. 6 from ``results[name] = [{"lo", "hi", "success_rate", "success_ci"}, ...]``."""
     fig, ax = plt.subplots(figsize=(5.5, 4), dpi=100)
     for (name, rows), colour in zip(results.items(), ("C0", "C3")):
         c = [100 * (r["lo"] + r["hi"]) / 2 for r in rows]
         y = [100 * r["success_rate"] for r in rows]
-        err = np.array([[100 * (r["success_rate"] - r["success_ci"][0]),
-                         100 * (r["success_ci"][1] - r["success_rate"])] for r in rows]).T
+        err = np.clip(np.array([[100 * (r["success_rate"] - r["success_ci"][0]),
+                                 100 * (r["success_ci"][1] - r["success_rate"])]
+                                for r in rows]).T, 0, None)  # Wilson at k = n: -1e-16
         ax.errorbar(c, y, yerr=err, marker="o", capsize=3, color=colour, label=name)
     ax.set_xlabel("start distance from home (cm)")
     ax.set_ylabel(f"success rate (%) of {trials} trials per bin")
@@ -376,9 +385,8 @@ def run_success(out: str, trials: int, workers: int, seed: int, bins=FIG6_BINS,
     ax.set_title(f"Fig. 6-like: fixed nest at the arena centre, no compass\n"
                  f"({max_steps} steps max; 95% Wilson intervals)", fontsize=10)
     fig.tight_layout()
-    fig.savefig(os.path.join(out, "fig6_success.png"))
+    fig.savefig(path)
     plt.close(fig)
-    return results
 
 
 def main(argv: list[str] | None = None) -> int:
