@@ -70,6 +70,11 @@ class Controller(ABC):
     def on_reset(self) -> None:
         """Clear per-episode memory (called by :meth:`reset`)."""
 
+    def observation_keys(self) -> tuple[str, ...]:
+        """The env observation keys this controller reads (the harness asks the env for
+        them when the user did not choose ``obs_keys``)."""
+        return ("panorama", "goal")
+
     # -- the interface the harness uses ------------------------------------------------------
     def configure(self, spec: MotionSpec) -> None:
         """Tell the controller the env's command interface (action type and limits)."""

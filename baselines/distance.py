@@ -563,6 +563,12 @@ class DistanceController(Controller):
         self.last_estimate: PoseEstimate | None = None
         self.last_diagnostics: Diagnostics | None = None
 
+    def observation_keys(self) -> tuple[str, ...]:
+        """``goal_step`` too unless the interim nest map is asked for (``nest="resection"``)."""
+        if self.nest == "resection":
+            return ("panorama", "goal")
+        return ("panorama", "goal", "goal_step")
+
     def _commanded_step(self) -> float:
         """Forward travel (m) of the actions planned for the step and settle moves."""
         actions = [a for m in self._travel for a in self._helper.plan(m)]

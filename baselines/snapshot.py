@@ -442,11 +442,11 @@ class SnapshotController(Controller):
         self._stopped = False
         self.last_estimate: HomingEstimate | None = None
 
-    def _keys(self) -> tuple[str, str]:
+    def observation_keys(self) -> tuple[str, str]:
         return ("panorama", "goal") if self.source == "panorama" else ("omni", "goal_omni")
 
     def decide(self, observation: dict[str, np.ndarray]) -> Move | None:
-        now_key, goal_key = self._keys()
+        now_key, goal_key = self.observation_keys()
         if now_key not in observation or goal_key not in observation:
             raise ValueError(f"snapshot (source={self.source!r}) needs the observation keys "
                              f"{now_key!r} and {goal_key!r}; got {sorted(observation)} "

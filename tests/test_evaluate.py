@@ -94,7 +94,8 @@ def test_eval_cli_writes_json_and_csv(tmp_path, capsys):
                           "--out", str(out)]) == 0
     doc = json.loads(out.read_text())
     assert doc["schema"] == 1 and doc["policy"] == "random" and doc["seed"] == 4
-    assert doc["params"]["step_length"] == 0.15 and doc["env_kwargs"] == SHORT
+    assert doc["params"]["step_length"] == 0.15
+    assert doc["env_kwargs"] == {**SHORT, "obs_keys": ["panorama", "goal"]}   # recorded as used
     for key in ("episodes", "success_rate", "success_ci", "spl", "soft_spl",
                 "final_distance_mean", "path_length_mean", "steps_mean", "success_by_distance"):
         assert key in doc["summary"]
@@ -167,3 +168,15 @@ def test_sb3_model_zip_is_evaluated(tmp_path):
     with pytest.raises(ValueError, match="observation_space"):
         evaluate(str(path), ENV_ID, episodes=1, env_kwargs={"obs_keys": ["signature"]},
                  progress=False)
+
+
+def test_evaluate_gives_a_controller_the_observation_keys_it_reads():
+    from train.evaluate import evaluate
+
+    result = evaluate("distance", episodes=1, seed=3, workers=1, progress=False,
+                      env_kwargs={"max_episode_steps": 3})
+    assert result.env_kwargs["obs_keys"] == ["panorama", "goal", "goal_step"]
+    chosen = evaluate("distance", episodes=1, seed=3, workers=1, progress=False,
+                      env_kwargs={"max_episode_steps": 3, "obs_keys": ["panorama", "goal"]})
+    assert chosen.env_kwargs["obs_keys"] == ["panorama", "goal"]
+    assert chosen.episodes[0].start_pose == result.episodes[0].start_pose

@@ -299,6 +299,9 @@ def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int =
         raise ValueError(f"unknown env id {env_id!r}; homing-gym ids: {list(homing_gym.ENV_IDS)}")
     spec = policy_spec(policy, params)
     env_kwargs = dict(env_kwargs or {})
+    if spec.kind == "controller" and "obs_keys" not in env_kwargs:
+        # what the controller reads; observation keys never change the episodes
+        env_kwargs["obs_keys"] = list(spec.build().observation_keys())
     tasks = [(seed + i, None) for i in range(episodes)]
     records = run_episodes(spec, env_id, env_kwargs, tasks, workers, progress,
                            desc=f"{spec.label}")
