@@ -156,29 +156,21 @@ def test_controller_reaches_home_from_1m_in_arena():
     one (docs/yu_kim.md), so that episode fails (a limit of the method, not hidden)."""
     gym = pytest.importorskip("gymnasium")
     import homing_gym  # noqa: F401
-    from baselines.motion import MotionSpec
+    from train.evaluate import prepare_policy, run_episode
 
     env = gym.make("homing_gym/LocalHoming-v0", obs_keys=("panorama", "goal", "goal_step"),
                    max_episode_steps=300)
     controller = DistanceController()
-    controller.configure(MotionSpec.from_env(env))
+    prepare_policy(controller, env)
     home = (0.05, -0.1, 0.4)
-    successes, collisions = [], []
     try:
-        for k in range(4):
-            start = free_start(env, home, 1.0, 0.3 + k * math.pi / 2, 1.0 - k)
-            obs, info = env.reset(seed=0, options={"home": home, "start": start})
-            controller.reset(0)
-            done, start_flag = False, True
-            while not done:
-                action, _ = controller.predict(obs, episode_start=start_flag)
-                start_flag = False
-                obs, _, terminated, truncated, info = env.step(action)
-                done = terminated or truncated
-            successes.append(bool(info["is_success"]))
-            collisions.append(int(info["collisions"]))
+        records = [run_episode(env, controller, 0,
+                               start=free_start(env, home, 1.0, 0.3 + k * math.pi / 2, 1.0 - k),
+                               home=home) for k in range(4)]
     finally:
         env.close()
+    successes = [r.success for r in records]
+    collisions = [r.collisions for r in records]
     assert sum(successes) >= 3, (successes, collisions)
 
 

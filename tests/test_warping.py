@@ -96,22 +96,14 @@ def test_rendered_pairs_03m_apart_point_home(arena):
 
 
 def test_controller_reaches_home_from_05m(arena):
-    from baselines.motion import MotionSpec
+    from train.evaluate import prepare_policy, run_episode
 
     controller = WarpingController()
-    controller.configure(MotionSpec.from_env(arena))
+    prepare_policy(controller, arena)
     home = (0.05, -0.1, 0.4)
     for k in range(2):
         start = free_start(arena, home, 0.5, 1.0 + k * math.pi, 2.0 * k - 1)
-        obs, info = arena.reset(seed=0, options={"home": home, "start": start})
-        controller.reset(0)
-        done, first = False, True
-        while not done:
-            action, _ = controller.predict(obs, episode_start=first)
-            first = False
-            obs, _, terminated, truncated, info = arena.step(action)
-            done = terminated or truncated
-        assert info["is_success"], start
+        assert run_episode(arena, controller, 0, start=start, home=home).success, start
 
 
 def test_bad_parameters_raise():
