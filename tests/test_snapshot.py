@@ -189,16 +189,9 @@ def test_route_first_targets_in_stop_mode(make_env):
                    "red cylinders 0.5 m from its centre) is smaller than 0.5 m: see docs/hong.md")
 def test_controller_reaches_home_from_half_a_metre_in_the_arena(make_env):
     env = make_env(panorama_shape=PANORAMA, start_distance=(0.5, 0.5), success_on="stop")
+    from train.evaluate import prepare_policy, run_episode
+
     c = SnapshotController()
-    c.configure(MotionSpec.from_env(env))
-    successes = 0
-    for seed in range(4):
-        obs, _ = env.reset(seed=seed)
-        c.reset(seed)
-        done = False
-        while not done:
-            action, _ = c.predict(obs)
-            obs, _, terminated, truncated, info = env.step(action)
-            done = terminated or truncated
-        successes += bool(info["is_success"])
+    prepare_policy(c, env)
+    successes = sum(run_episode(env, c, seed).success for seed in range(4))
     assert successes >= 3
