@@ -396,16 +396,16 @@ class SnapshotController(Controller):
     k_psi_tracked: float = 10.0
     initial_deviation: str = "search"
     k_psi_compass: float = 30.0
-    n_points: int = 15
-    min_instant: float = 0.02
-    min_total: float = 0.08
-    k_high: float = 1.0
-    k_low: float = 0.25
-    k_psi: float = 180.0
-    k_omega: float = 56.0
-    k_front: float = 0.0
-    k_back: float = 30.0
-    target_stats: str = "candidate"
+    n_points: int = HongConfig.n_points
+    min_instant: float = HongConfig.min_instant
+    min_total: float = HongConfig.min_total
+    k_high: float = HongConfig.k_high
+    k_low: float = HongConfig.k_low
+    k_psi: float = HongConfig.k_psi
+    k_omega: float = HongConfig.k_omega
+    k_front: float = HongConfig.k_front
+    k_back: float = HongConfig.k_back
+    target_stats: str = HongConfig.target_stats
 
     def validate(self) -> None:
         if self.source not in SOURCES:
