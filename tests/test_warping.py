@@ -106,6 +106,17 @@ def test_controller_reaches_home_from_05m(arena):
         assert run_episode(arena, controller, 0, start=start, home=home).success, start
 
 
+def test_controller_follows_a_new_goal_image(arena):
+    """On a route the goal image changes mid-episode: the controller must home on the new
+    one (it stops where the new goal was taken), not on the first snapshot."""
+    controller = WarpingController()
+    controller.reset()
+    here = _render(arena, (0.05, -0.1, 0.4))
+    first_goal = _render(arena, (-0.5, 0.4, 0.4))
+    assert controller.decide({"panorama": here, "goal": first_goal}) is not None
+    assert controller.decide({"panorama": here, "goal": here.copy()}) is None
+
+
 def test_bad_parameters_raise():
     with pytest.raises(ValueError):
         WarpingConfig(rho_values=(0.0, 1.0))

@@ -6,7 +6,8 @@ image-goal navigation work reports to work far better than separate encoders), a
 convolutions with *circular* padding along azimuth, since a 360-degree panorama has no left
 or right edge, and zero padding along elevation. Other Box observations (e.g.
 ``odometry``, ``signature``) are flattened and concatenated after the convolutional trunk.
-Sized for CPU training: 4 strided convolutions and one linear layer.
+Sized for CPU training: a 4 x 4 stride-4 patch layer, two stride-2 convolutions and
+one linear layer (about 8 M multiply-adds per 48 x 256 sample).
 """
 
 from __future__ import annotations
@@ -23,11 +24,12 @@ EXTRACTORS = ("panorama", "combined")
 
 class CircularConv(nn.Module):
     """``Conv2d`` with circular padding along the width (azimuth) and zeros along the
-    height, then ReLU."""
+    height, then ReLU. The padding, ``(kernel - stride + 1) // 2`` on each side, keeps the
+    output at ``input / stride`` (a patch layer, ``kernel == stride``, needs none)."""
 
     def __init__(self, c_in: int, c_out: int, kernel: int, stride: int):
         super().__init__()
-        self.pad = kernel // 2
+        self.pad = max(kernel - stride + 1, 0) // 2
         self.conv = nn.Conv2d(c_in, c_out, kernel, stride, padding=(self.pad, 0))
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
@@ -37,11 +39,13 @@ class CircularConv(nn.Module):
 
 class PanoramaGoalExtractor(BaseFeaturesExtractor):
     """Early-fusion CNN over ``image_keys`` (default: panorama and goal) stacked as channels;
-    other keys are flattened and appended. Output: ``features_dim`` + extra values."""
+    other keys are flattened and appended. ``layers``: (channels, kernel, stride) of each
+    convolution. Output: ``features_dim`` + extra values."""
 
     def __init__(self, observation_space: gym.spaces.Dict, features_dim: int = 256,
                  image_keys: tuple[str, ...] = ("panorama", "goal"),
-                 channels: tuple[int, ...] = (32, 64, 64, 64)):
+                 layers: tuple[tuple[int, int, int], ...] = ((32, 4, 4), (64, 3, 2),
+                                                             (64, 3, 2))):
         missing = [k for k in image_keys if k not in observation_space.spaces]
         if missing:
             raise ValueError(f"PanoramaGoalExtractor needs observation keys {missing}; the "
@@ -56,11 +60,11 @@ class PanoramaGoalExtractor(BaseFeaturesExtractor):
         self.image_keys = tuple(image_keys)
         self.extra_keys = tuple(extra_keys)
         c_in = sum(observation_space[k].shape[0] for k in image_keys)   # SB3 gives CHW
-        layers, kernels = [], (5, 3, 3, 3)
-        for c_out, kernel in zip(channels, kernels):
-            layers.append(CircularConv(c_in, c_out, kernel, stride=2))
+        convs = []
+        for c_out, kernel, stride in layers:
+            convs.append(CircularConv(c_in, c_out, kernel, stride))
             c_in = c_out
-        self.cnn = nn.Sequential(*layers, nn.Flatten())
+        self.cnn = nn.Sequential(*convs, nn.Flatten())
         with torch.no_grad():
             sample = torch.zeros(1, sum(observation_space[k].shape[0] for k in image_keys),
                                  *observation_space[image_keys[0]].shape[1:])
