@@ -36,19 +36,22 @@ def test_smoke_run_writes_a_complete_run_folder(tmp_path, extractor):
 
 
 def test_save_load_round_trip_gives_identical_actions(tmp_path):
+    """The model in memory after training and the same model saved and loaded act alike."""
     import gymnasium as gym
     from stable_baselines3 import PPO
 
-    run = tmp_path / "run"
-    model = None
-    main(["--timesteps", "128", "--out", str(run), *TINY])
-    model = PPO.load(run / "model.zip")
-    again = PPO.load(run / "model.zip")
-    env = gym.make("homing_gym/LocalHoming-v0", panorama_shape=(36, 64))
+    from train.extractor import policy_kwargs_for
+
+    env = gym.make("homing_gym/LocalHoming-v0", panorama_shape=(36, 64), max_episode_steps=16)
+    model = PPO("MultiInputPolicy", env, n_steps=32, batch_size=16, n_epochs=1, seed=0,
+                policy_kwargs=policy_kwargs_for("panorama", features_dim=32))
+    model.learn(32)
+    model.save(tmp_path / "model.zip")
+    loaded = PPO.load(tmp_path / "model.zip")
     obs, _ = env.reset(seed=0)
     for _ in range(5):
         a, _ = model.predict(obs, deterministic=True)
-        b, _ = again.predict(obs, deterministic=True)
+        b, _ = loaded.predict(obs, deterministic=True)
         assert np.array_equal(a, b)
         obs, *_ = env.step(a)
     env.close()

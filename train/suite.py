@@ -1,6 +1,6 @@
 """``homing-suite``: the package's main job, the comparison of every method on one suite.
 
-    homing-suite                       # 50 episodes of LocalHoming-v0, seed 0, into results/
+    homing-suite                       # 20 episodes of LocalHoming-v0, seed 0, into results/
     homing-suite --episodes 200 --workers 2 --out results/full
 
 Evaluates every registered scripted controller (``baselines.available()``) and every
@@ -36,7 +36,7 @@ def shipped_policies(folder: Path = POLICY_DIR) -> dict[str, tuple[Path, dict]]:
     return found
 
 
-def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 50, seed: int = 0,
+def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: int = 0,
               workers: int = 2, methods: list[str] | None = None) -> dict[str, str]:
     """Evaluate the methods (default: all controllers and shipped policies) and compare."""
     out.mkdir(parents=True, exist_ok=True)
@@ -62,7 +62,7 @@ def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 50, seed: in
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="homing-suite", description=__doc__.split("\n")[0])
     parser.add_argument("--env", default=DEFAULT_ENV)
-    parser.add_argument("--episodes", type=int, default=50)
+    parser.add_argument("--episodes", type=int, default=20)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--methods", nargs="+", help="subset of methods (default: all)")
