@@ -144,7 +144,8 @@ def check_bearings(current, goal) -> tuple[np.ndarray, np.ndarray]:
         bad = np.argwhere(~np.isfinite(arr))
         if bad.size:
             idx = tuple(int(v) for v in bad[0])
-            raise ValueError(f"{name} bearings{list(idx)} is {arr[idx]!r}; bearings must be finite")
+            raise ValueError(f"{name} bearings{list(idx)} is {float(arr[idx])!r}; "
+                             "bearings must be finite")
     return cur, tgt
 
 
