@@ -64,7 +64,6 @@ TWO_PI = 2.0 * math.pi
 #: of a separation, which §6 puts at 0.027 rad for a 1394-pixel panorama and 3-pixel error.
 DEFAULT_STOP_TOL = 0.005
 
-LawName = Literal["basic", "complementary", "unified"]
 LAWS: tuple[str, ...] = ("basic", "complementary", "unified")
 
 
@@ -99,8 +98,8 @@ class LawResult:
     *as summed* (the complementary law's inverted ones already negated). ``pairs``: the
     ``(i, j)`` of each row. ``theta``, ``theta_goal``, ``delta_theta``: ``(P,)`` separations
     at ``A``, at ``T`` and their difference (radians). ``nlp``: row of the nearest
-    landmark pair. ``similar``: the stop test :func:`snapshots_similar` with the default
-    tolerance (separations). ``state`` and ``criterion``: the unified law's state after
+    landmark pair. ``similar``: the stop test :func:`snapshots_similar` on separations
+    (default tolerance; the unified law's ``UnifiedConfig.stop_tol``). ``state`` and ``criterion``: the unified law's state after
     this step and the criterion that set it (``None`` for the other laws).
     """
 

@@ -9,6 +9,11 @@ landmarks, the circle ``C^`` through them, the triangle ``T^`` and the wedges ``
 marked. Writes ``reachability_<law>.png``, ``reachability.png`` (the three side by side)
 and ``reachability.json`` (per-region fractions) under ``--out``, and prints a Markdown
 table of the fractions.
+
+    python -m train.bearing_figures starts --out docs/bearing
+
+``starts`` repeats the unified law's map (coarser grid, no figure) from starts in every
+region and writes ``starts.json`` and a Markdown table: how much depends on ``A``.
 """
 
 from __future__ import annotations
@@ -150,9 +155,31 @@ def reachability(out: str, grid: int = 81, extent: float = 4.0,
     return fractions
 
 
-def markdown_table(fractions: dict[str, dict[str, float]]) -> str:
+#: Starts of the ``starts`` table (m): T^, C^ - T^, two in H^, two in the rest.
+STARTS = [(0.1, 0.0), (0.2, -0.95), (3.0, -3.0), (-2.5, -2.0), (-3.0, 3.0), (0.0, -2.0)]
+
+
+def starts_table(out: str, grid: int = 41, extent: float = 4.0, law: str = "unified",
+                 config: SimConfig | None = None,
+                 progress: bool = True) -> dict[str, dict[str, float]]:
+    """Per-region fractions of goals reached by ``law`` from each of :data:`STARTS`."""
+    cfg = config or SimConfig()
+    os.makedirs(out, exist_ok=True)
+    xs = np.linspace(-extent, extent, grid)
+    table = {}
+    for start in tqdm(STARTS, desc=f"{law} from {len(STARTS)} starts", disable=not progress):
+        rmap = reachability_map(LANDMARKS, law, xs, xs, start=start, config=cfg)
+        name = f"A = {start} ({REGION_LABELS[str(region(LANDMARKS, np.array(start)))]})"
+        table[name] = region_fractions(rmap)
+    with open(os.path.join(out, "starts.json"), "w") as f:
+        json.dump({"law": law, "grid": grid, "extent": extent, "fractions": table}, f,
+                  indent=2)
+    return table
+
+
+def markdown_table(fractions: dict[str, dict[str, float]], first: str = "law") -> str:
     """Per-region fractions of reached goals as a Markdown table."""
-    lines = ["| law | " + " | ".join(REGION_LABELS[r] for r in REGIONS) + " |",
+    lines = [f"| {first} | " + " | ".join(REGION_LABELS[r] for r in REGIONS) + " |",
              "|---|" + "---|" * len(REGIONS)]
     for law, fr in fractions.items():
         lines.append(f"| {law} | " + " | ".join(f"{100 * fr[r]:.1f}%" for r in REGIONS) + " |")
@@ -168,11 +195,18 @@ def main(argv: list[str] | None = None) -> int:
     rp.add_argument("--extent", type=float, default=4.0, help="half-width of the map (m)")
     rp.add_argument("--start", type=float, nargs=2, default=START, help="start A (m)")
     rp.add_argument("--no-progress", action="store_true")
+    sp = sub.add_parser("starts", help="the unified law's per-region reach from several starts")
+    sp.add_argument("--out", default="docs/bearing", help="output folder")
+    sp.add_argument("--grid", type=int, default=41, help="grid points per axis")
+    sp.add_argument("--no-progress", action="store_true")
     args = parser.parse_args(argv)
     if args.command == "reachability":
         fractions = reachability(args.out, args.grid, args.extent, args.start,
                                  progress=not args.no_progress)
         print(markdown_table(fractions))
+    elif args.command == "starts":
+        table = starts_table(args.out, args.grid, progress=not args.no_progress)
+        print(markdown_table(table, first="start"))
     return 0
 
 
