@@ -36,6 +36,7 @@ from train.policies import policy_spec
 PANORAMA = (60, 360)   # 1 deg per column, Hong's sampling interval
 LOCAL = "homing_gym/LocalHoming-v0"
 ROUTE = "homing_gym/RouteFollowing-v0"
+PER_METHOD = ("field", "eval", "route")   # results keyed "method/setting": a run adds its own
 SWEEP: list[tuple[str, dict[str, Any]]] = [
     ("defaults", {}),
     ("k_back = 8 (paper)", {"k_back": 8.0}),
@@ -291,7 +292,11 @@ def main(argv: list[str] | None = None) -> int:
              "eval": lambda: run_eval(names, args.episodes),
              "route": lambda: run_routes(names, args.routes)}
     for key in args.only:
-        results[key] = steps[key]()
+        value = steps[key]()
+        if key in PER_METHOD and isinstance(results.get(key), dict):
+            results[key].update(value)      # keep the other methods' entries
+        else:
+            results[key] = value
         with open(path, "w") as f:
             json.dump(results, f, indent=1, default=float)
         print(key, json.dumps(results[key], indent=1, default=float))
