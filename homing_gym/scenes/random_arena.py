@@ -2,8 +2,10 @@
 
 3-8 landmarks of random shape (cylinder or box), size, colour, texture and position
 (non-overlapping, at least 0.45 m of clearance between footprints so the robot fits
-between them), and randomly textured walls and floor, all drawn from the episode's
-random generator. Made for training policies that generalise to unseen scenes.
+between them), and random walls and floor, all drawn from the episode's random generator.
+Each wall and the floor is textured or, with probability ``PLAIN_PROBABILITY``, a plain
+random colour (walls pale, floor grey), so that plain rooms like the ``arena`` are part of
+the distribution. Made for training policies that generalise to unseen scenes.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ FLOOR_TEXTURES = ("floor_tiles", "concrete", "wood_light", "wood_dark", "checker
 LANDMARK_TEXTURES = (None, None, "stripes_warm", "stripes_cool", "checker_green", "poster_a",
                      "poster_b", "bricks_red")
 CLEARANCE = 0.45
+PLAIN_PROBABILITY = 0.3
 
 
 def random_arena_scene(rng: np.random.Generator) -> Scene:
@@ -42,15 +45,28 @@ def random_arena_scene(rng: np.random.Generator) -> Scene:
             height=float(rng.uniform(0.15, 0.8)), yaw=float(rng.uniform(-np.pi, np.pi)),
             color=color, texture=LANDMARK_TEXTURES[rng.integers(len(LANDMARK_TEXTURES))],
             name=f"landmark{len(landmarks)}"))
-    wall_textures = rng.choice(WALL_TEXTURES, size=4)
     walls = tuple(
-        Wall(w.start, w.end, height=w.height, thickness=w.thickness, texture=str(t))
-        for w, t in zip(square_walls(ARENA_SIDE, height=0.6), wall_textures))
+        Wall(w.start, w.end, height=w.height, thickness=w.thickness,
+             **_surface(rng, WALL_TEXTURES, low=0.7, high=1.0))
+        for w in square_walls(ARENA_SIDE, height=0.6))
+    floor = _surface(rng, FLOOR_TEXTURES, low=0.3, high=0.8)
     return Scene(
         name="random_arena",
         bounds=((-half, -half), (half, half)),
         walls=walls,
         landmarks=tuple(landmarks),
-        floor_color=(1.0, 1.0, 1.0, 1.0),
-        floor_texture=str(FLOOR_TEXTURES[rng.integers(len(FLOOR_TEXTURES))]),
+        floor_color=floor["color"],
+        floor_texture=floor["texture"],
     )
+
+
+def _surface(rng: np.random.Generator, textures: tuple[str, ...], low: float,
+             high: float) -> dict:
+    """``color`` and ``texture`` of a wall or floor: a texture from ``textures`` on white,
+    or (with ``PLAIN_PROBABILITY``) no texture and a near-grey colour of brightness in
+    ``[low, high]``."""
+    if rng.random() < PLAIN_PROBABILITY:
+        grey = rng.uniform(low, high) + rng.uniform(-0.05, 0.05, 3)
+        return {"color": tuple(float(c) for c in np.clip(grey, 0, 1)) + (1.0,),
+                "texture": None}
+    return {"color": (1.0, 1.0, 1.0, 1.0), "texture": str(textures[rng.integers(len(textures))])}
