@@ -122,3 +122,30 @@ def test_suite_evaluates_and_compares_methods_on_one_suite(tmp_path, capsys):
         assert (tmp_path / name).is_file(), name
     with pytest.raises(SystemExit):
         suite_main(["--methods", "telepathy", "--out", str(tmp_path)])
+
+
+def test_ship_copies_the_best_model_with_eval_settings_and_curve(tmp_path):
+    from train.ship import ship_run
+
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "best_model.zip").write_bytes(b"best")
+    (run / "model.zip").write_bytes(b"final")
+    (run / "learning_curve.png").write_bytes(b"png")
+    (run / "command.txt").write_text("homing-train --seed 3\n")
+    (run / "summary.json").write_text(json.dumps(
+        {"timesteps": 1000, "wall_time_s": 10.0, "env_steps_per_s": 100.0}))
+    (run / "config.yml").write_text(yaml.safe_dump({
+        "env_id": "homing_gym/LocalHoming-v0",
+        "env_kwargs": {"scene": "random_arena", "action_type": "discrete"}}))
+    shipped = tmp_path / "shipped"
+    target = ship_run(run, "p", shipped)
+    assert target.read_bytes() == b"best"
+    meta = yaml.safe_load((shipped / "p.yml").read_text())
+    assert meta["eval_env_kwargs"] == {"action_type": "discrete"}
+    assert meta["timesteps"] == 1000 and meta["commands"] == ["homing-train --seed 3"]
+    assert (shipped / "p_curve.png").read_bytes() == b"png"
+    assert ship_run(run, "q", shipped, final=True).read_bytes() == b"final"
+    (run / "summary.json").unlink()
+    with pytest.raises(ValueError, match="summary.json"):
+        ship_run(run, "r", shipped)
