@@ -2,7 +2,8 @@
 
 >>> import baselines
 >>> baselines.available()
-['distance', 'oracle', 'random', 'snapshot', 'warping']
+['bearing', 'bearing-basic', 'bearing-complementary', 'distance', 'oracle', 'random',
+ 'snapshot', 'warping']
 >>> controller = baselines.make("oracle", step_length=0.2)
 """
 
@@ -13,6 +14,8 @@ from typing import Any
 
 from baselines.base import Controller
 from baselines.motion import MotionHelper, MotionSpec, Move
+from baselines.bearing import (BasicBearingController, BearingController,
+                               ComplementaryBearingController)
 from baselines.distance import DistanceController
 from baselines.oracle import OracleController
 from baselines.random_walk import RandomController
@@ -63,6 +66,9 @@ register("random", RandomController)
 register("distance", DistanceController)
 register("warping", WarpingController)
 register("snapshot", SnapshotController)
+register("bearing", BearingController)
+register("bearing-basic", BasicBearingController)
+register("bearing-complementary", ComplementaryBearingController)
 
 __all__ = ["Controller", "MotionHelper", "MotionSpec", "Move", "OracleController",
            "RandomController", "available", "controller_class", "make", "parameters",

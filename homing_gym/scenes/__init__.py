@@ -15,6 +15,7 @@ import numpy as np
 from homing_gym.scenes.arena import arena_scene
 from homing_gym.scenes.base import SHAPES, Landmark, Scene, Wall, square_walls
 from homing_gym.scenes.hallway import hallway_scene
+from homing_gym.scenes.lab import lab_scene
 from homing_gym.scenes.random_arena import random_arena_scene
 
 
@@ -56,6 +57,10 @@ register_scene("arena", SceneFactory(
 register_scene("hallway", SceneFactory(
     build=lambda rng: hallway_scene(),
     description="Hong et al. 1991 corridor: 8 x 1.8 m, doors, posters, lamps; has a route"))
+register_scene("lab", SceneFactory(
+    build=lambda rng: lab_scene(),
+    description="Bekris et al. Fig. 9 lab: 6 x 5 m, three coloured poster columns, "
+                "door, desk, boxes; marked positions A-F"))
 register_scene("random_arena", SceneFactory(
     build=random_arena_scene, randomised=True,
     description="2.4 m square, 3-8 random landmarks and textures per episode"))
