@@ -15,6 +15,7 @@ __version__ = "0.1.0"
 _ENVS = {
     "homing_gym/LocalHoming-v0": ("homing_gym.envs:LocalHomingEnv", 500),
     "homing_gym/RouteFollowing-v0": ("homing_gym.envs:RouteFollowingEnv", 1000),
+    "homing_gym/LongRangeHoming-v0": ("homing_gym.envs:LongRangeHomingEnv", 2500),
 }
 ENV_IDS: tuple[str, ...] = tuple(_ENVS)
 
@@ -29,7 +30,7 @@ def register_envs() -> None:
 register_envs()
 
 from homing_gym.env import HomingEnv  # noqa: E402
-from homing_gym.envs import LocalHomingEnv, RouteFollowingEnv  # noqa: E402
+from homing_gym.envs import LocalHomingEnv, LongRangeHomingEnv, RouteFollowingEnv  # noqa: E402
 
-__all__ = ["ENV_IDS", "HomingEnv", "LocalHomingEnv", "RouteFollowingEnv", "register_envs",
-           "__version__"]
+__all__ = ["ENV_IDS", "HomingEnv", "LocalHomingEnv", "LongRangeHomingEnv", "RouteFollowingEnv",
+           "register_envs", "__version__"]

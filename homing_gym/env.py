@@ -18,6 +18,7 @@ from gymnasium import spaces
 
 from homing_gym.geometry import to_frame
 from homing_gym.panorama import CameraConfig, Lighting, PanoramaCamera, random_lighting
+from homing_gym.perspective import PerspectiveConfig, render_perspective
 from homing_gym.robot import RobotConfig, WheelOdometry
 from homing_gym.scenes import scene_factory
 from homing_gym.scenes.base import Scene
@@ -134,6 +135,18 @@ class HomingEnv(gym.Env):
         """Panorama (uint8 HWC) the robot's camera would see at ``pose`` in the current
         world and the episode's lighting, rendered as is (the robot body stays where it is)."""
         return self.camera.render(self.sim.client, pose, self._lighting)
+
+    def render_view(self, pose=None, size: tuple[int, int] = (640, 480),
+                    hfov_deg: float = 60.0) -> np.ndarray:
+        """An ordinary perspective view (uint8 ``(height, width, 3)``) from the robot's
+        camera at ``pose`` (default: the robot's current pose; ``(x, y, yaw)`` in metres
+        and radians), ``size = (width, height)`` pixels and ``hfov_deg`` degrees of
+        horizontal field of view, under the episode's lighting. The world and the
+        episode are left untouched (see :mod:`homing_gym.perspective`)."""
+        config = PerspectiveConfig(width=size[0], height=size[1], hfov=math.radians(hfov_deg))
+        return render_perspective(self.sim.client, self.pose if pose is None else pose,
+                                  self.robot_config.camera_height, config,
+                                  self.sim.renderer, self._lighting)
 
     @property
     def goal_pose(self) -> np.ndarray:
@@ -264,7 +277,7 @@ class HomingEnv(gym.Env):
     def step(self, action):
         if self.episode is None:
             raise RuntimeError("call reset() before step()")
-        v, w, stopped = self._command(action)
+        v, w, stopped = self.task.command(self, *self._command(action))
         robot = self.sim.robot
         robot.drive(v * self.robot_config.max_speed, w * self.robot_config.max_yaw_rate)
         collision = self.sim.step(self.physics_substeps)

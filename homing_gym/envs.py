@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from homing_gym.env import HomingEnv
 from homing_gym.scenes.base import Scene
-from homing_gym.tasks import LocalHomingTask, RewardConfig, RouteFollowingTask
+from homing_gym.tasks import (LocalHomingTask, LongRangeHomingTask, RewardConfig,
+                              RouteFollowingTask)
 from homing_gym.tasks.route_following import FOOT
 
 
@@ -181,3 +182,94 @@ class RouteFollowingEnv(HomingEnv):
                                   start_jitter=start_jitter, success_radius=success_radius,
                                   success_on=success_on, reward=reward)
         super().__init__(task, scene, **kwargs)
+
+
+class LongRangeHomingEnv(HomingEnv):
+    """## Description
+
+    Long-range visual homing (Bekris, Argyros & Kavraki §3 and §5, Fig. 12). The robot
+    stands at home, where the goal panorama is taken. Each episode starts with an
+    *outbound phase*: the env itself drives the robot along a seeded route of
+    ``route_length`` = 8 m (polyline legs of 0.8-2 m turning by up to 120 degrees, every
+    point at least 0.3 m clear of walls and objects) while the agent watches every frame,
+    as the paper's robot "after executing a predetermined set of motion commands, reaches
+    position G, covering a distance of approximately eight meters". Then the *homing
+    phase* begins and the agent must bring the robot back home from the end of the route,
+    where home usually shares no view features with the current panorama. Default scene:
+    ``lab`` (6 x 5 m, three coloured poster columns, door, desk, boxes, textured walls);
+    any scene with room for the route works.
+
+    ## Action space
+
+    As ``LocalHoming-v0``: ``Box(-1, 1, (2,), float32)`` (forward speed, yaw rate; max
+    0.3 m/s and 1.5 rad/s) or ``Discrete(4)`` with ``action_type="discrete"``; control
+    period 0.1 s. During the outbound phase actions are validated (a bad action still
+    raises ``ValueError``) and ignored.
+
+    ## Observation space
+
+    As ``LocalHoming-v0`` (``obs_keys``, default ``("panorama", "goal", "phase")``), plus:
+
+    | key | space | meaning |
+    |---|---|---|
+    | `phase` | `Discrete(2)` | 0 outbound (the env drives), 1 homing (the agent drives) |
+
+    ``goal`` is the home snapshot throughout. ``odometry`` (if asked for) integrates the
+    wheel encoders from home, over the outbound route too.
+
+    ## Rewards
+
+    0 during the outbound phase. Then as ``LocalHoming-v0``: ``progress * (d_prev - d)``
+    ``+ success`` once ``- collision`` per step with contact ``- time`` per step; defaults
+    1.0, 10.0, 0.1, 0.01. Terms in ``info["rewards"]``.
+
+    ## Starting state
+
+    Home: a uniformly drawn pose with at least 0.3 m of clearance; the robot starts there.
+    The route is drawn from the same seed (``reset(seed=...)``). The outbound driver
+    turns on the spot towards the next waypoint when it is more than 0.2 rad off the
+    heading and otherwise drives at ``outbound_speed`` = 0.15 m/s, steering at up to
+    ``outbound_yaw_rate`` = 0.5 rad/s (slow, like the paper's 4 cm/s and 3 deg/s, so that
+    features move little between frames); a waypoint is passed within 5 cm. An 8 m route
+    takes about 600-800 steps. ``reset(options={"home": ..., "start": ...})`` as in
+    ``LocalHoming-v0``; the route then starts at ``start``.
+
+    ## Episode end
+
+    Never during the outbound phase. In the homing phase, terminated on success:
+    ``success_on="reach"`` (default) when the robot centre comes within
+    ``success_radius`` = 0.2 m of home; ``success_on="stop"`` when the agent issues stop
+    (a success if within ``success_radius``). Truncated after ``max_episode_steps`` =
+    2500 steps in all (outbound steps included).
+
+    ## Info
+
+    As ``LocalHoming-v0`` (``goal_pose`` is home), plus ``phase``, ``outbound_steps``
+    (steps of the outbound phase so far) and ``route`` (the waypoints, ``(K, 2)`` metres,
+    starting at home). Ground truth: for metrics, not for agents.
+
+    ## Arguments
+
+    ``scene`` (default ``"lab"``), ``route_length`` = 8.0 (metres, 0.5-30),
+    ``outbound_speed`` = 0.15 (m/s, at most ``max_speed``), ``outbound_yaw_rate`` = 0.5
+    (rad/s, at most ``max_yaw_rate``), ``success_radius``, ``success_on``, ``reward``,
+    ``obs_keys`` and every camera and robot argument of ``LocalHoming-v0``. A scene that
+    cannot hold the route raises ``ValueError`` at reset.
+
+    ## Version history
+
+    * v0: initial release.
+    """
+
+    def __init__(self, scene: str | Scene = "lab", *, route_length: float = 8.0,
+                 outbound_speed: float = 0.15, outbound_yaw_rate: float = 0.5,
+                 success_radius: float = 0.2, success_on: str = "reach",
+                 reward: RewardConfig = RewardConfig(),
+                 obs_keys: tuple[str, ...] | list[str] = ("panorama", "goal", "phase"),
+                 **kwargs):
+        task = LongRangeHomingTask(route_length=route_length, outbound_speed=outbound_speed,
+                                   outbound_yaw_rate=outbound_yaw_rate,
+                                   success_radius=success_radius, success_on=success_on,
+                                   reward=reward)
+        super().__init__(task, scene, obs_keys=obs_keys, **kwargs)
+        task.check_limits(self.robot_config)

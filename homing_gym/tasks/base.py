@@ -47,6 +47,13 @@ class Task(ABC):
     def on_reset(self, env: "HomingEnv") -> None:
         """Called at the end of ``env.reset``, once the robot stands at the start."""
 
+    def command(self, env: "HomingEnv", v: float, w: float,
+                stopped: bool) -> tuple[float, float, bool]:
+        """The command the robot executes this step, from the agent's validated one
+        (normalised forward speed ``v``, yaw rate ``w``, stop flag). Default: the agent's;
+        a task may drive the robot itself (long-range homing's outbound phase)."""
+        return v, w, stopped
+
     @abstractmethod
     def step_outcome(self, env: "HomingEnv", collision: bool, stopped: bool) -> tuple[dict, bool, bool]:
         """After a control step: ``(reward terms, terminated, is_success)``."""

@@ -1,0 +1,166 @@
+"""Long-range homing (Bekris, Argyros & Kavraki §3 and §5, Fig. 12): the robot leaves
+home along a route of about 8 m driven by the env while the agent watches, then must
+return home from the end of the route by itself.
+
+Phase 0 (outbound): the env follows a seeded polyline route from the start (home) with
+a simple pursuit law at ``outbound_speed`` m/s and ``outbound_yaw_rate`` rad/s (turning on
+the spot first when a waypoint is more than 0.2 rad off the heading); the agent's
+actions are validated and ignored, no reward is paid and the episode cannot end. Phase 1
+(homing) starts once the last waypoint is reached: from then on the episode is
+:class:`~homing_gym.tasks.goal_reaching.GoalReachingTask` with home as its only goal.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+from gymnasium import spaces
+
+from homing_gym.geometry import bearing_to
+from homing_gym.robot import RobotConfig
+from homing_gym.scenes.base import Scene, clearance
+from homing_gym.tasks.base import Episode, sample_free_pose
+from homing_gym.tasks.goal_reaching import GoalReachingTask, RewardConfig
+
+if TYPE_CHECKING:
+    from homing_gym.env import HomingEnv
+
+OUTBOUND, HOMING = 0, 1
+#: A waypoint counts as passed within this distance (m).
+WAYPOINT_RADIUS = 0.05
+#: Heading error (rad) above which the outbound driver turns on the spot.
+TURN_FIRST = 0.2
+
+
+def segment_is_free(scene: Scene, a, b, margin: float, spacing: float = 0.05) -> bool:
+    """Whether every point of segment ``a``-``b`` (m) has ``margin`` m of clearance."""
+    n = max(2, math.ceil(math.dist(a, b) / spacing) + 1)
+    return all(clearance(scene, (a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])))
+               >= margin for t in np.linspace(0.0, 1.0, n))
+
+
+def plan_route(scene: Scene, start, rng: np.random.Generator, length: float,
+               margin: float, legs: tuple[float, float] = (0.8, 2.0),
+               max_restarts: int = 200) -> np.ndarray:
+    """A collision-free polyline ``(K, 2)`` (m) from ``start`` of total length ``length``:
+    legs of uniform length in ``legs``, each turning by up to 120 degrees from the last
+    (any direction for the first), every point ``margin`` m clear of walls and objects.
+    ``ValueError`` if the scene cannot hold such a route."""
+    for _ in range(max_restarts):
+        points = [np.asarray(start[:2], dtype=np.float64)]
+        heading = float(rng.uniform(-math.pi, math.pi))
+        total = 0.0
+        while total < length - 1e-9:
+            leg = min(float(rng.uniform(*legs)), length - total)
+            for _ in range(30):
+                turn = rng.uniform(-math.pi, math.pi) if len(points) == 1 \
+                    else rng.uniform(-2 * math.pi / 3, 2 * math.pi / 3)
+                h = heading + float(turn)
+                end = points[-1] + leg * np.array([math.cos(h), math.sin(h)])
+                if segment_is_free(scene, points[-1], end, margin):
+                    points.append(end)
+                    heading, total = h, total + leg
+                    break
+            else:
+                break
+        if total >= length - 1e-9:
+            return np.array(points)
+    raise ValueError(f"scene {scene.name!r} of size {scene.size} m cannot hold a route of "
+                     f"{length} m with {margin} m of clearance; use a larger scene or a "
+                     f"shorter route_length")
+
+
+class LongRangeHomingTask(GoalReachingTask):
+    """Outbound route then homing (module docstring). ``route_length`` (m, in
+    ``[0.5, 30]``), ``outbound_speed`` (m/s) and ``outbound_yaw_rate`` (rad/s, both at
+    most the robot's limits, checked by the env), ``clearance_margin`` (m) of the home
+    pose and of the route; ``success_radius``, ``success_on`` and ``reward`` as in
+    :class:`GoalReachingTask`."""
+
+    def __init__(self, route_length: float = 8.0, outbound_speed: float = 0.15,
+                 outbound_yaw_rate: float = 0.5, success_radius: float = 0.2,
+                 success_on: str = "reach", reward: RewardConfig = RewardConfig(),
+                 clearance_margin: float = 0.3):
+        if not (isinstance(route_length, (int, float)) and 0.5 <= route_length <= 30):
+            raise ValueError(f"route_length must be in [0.5, 30] metres, got {route_length!r}")
+        for name, value in (("outbound_speed", outbound_speed),
+                            ("outbound_yaw_rate", outbound_yaw_rate),
+                            ("clearance_margin", clearance_margin)):
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise ValueError(f"{name} must be a positive number, got {value!r}")
+        super().__init__(success_radius, success_on, reward)
+        self.route_length = float(route_length)
+        self.outbound_speed = float(outbound_speed)
+        self.outbound_yaw_rate = float(outbound_yaw_rate)
+        self.clearance_margin = float(clearance_margin)
+        self.route = np.zeros((0, 2))
+        self.phase = OUTBOUND
+        self.waypoint = 1
+        self.outbound_steps = 0
+
+    def check_scene(self, scene: Scene) -> None:
+        width, depth = scene.size
+        if min(width, depth) < 4 * self.clearance_margin:
+            raise ValueError(f"scene {scene.name!r} of size {width:.2f} x {depth:.2f} m is "
+                             f"too small for routes {self.clearance_margin} m clear of its "
+                             f"walls")
+
+    def check_limits(self, rc: RobotConfig) -> None:
+        """``ValueError`` unless the outbound speeds are within the robot's limits."""
+        if self.outbound_speed > rc.max_speed or self.outbound_yaw_rate > rc.max_yaw_rate:
+            raise ValueError(f"outbound_speed {self.outbound_speed} m/s and "
+                             f"outbound_yaw_rate {self.outbound_yaw_rate} rad/s must not "
+                             f"exceed max_speed {rc.max_speed} and max_yaw_rate "
+                             f"{rc.max_yaw_rate}")
+
+    def sample_episode(self, scene: Scene, rng: np.random.Generator) -> Episode:
+        home = sample_free_pose(scene, rng, self.clearance_margin)
+        return Episode(home=home, start=home.copy())
+
+    def on_reset(self, env: "HomingEnv") -> None:
+        # The robot starts where the previous episode may have ended (the same seed's
+        # home, e.g. after a one-step episode); PyBullet keeps contact points cached at
+        # that pose by proximity, with their warm-start impulses, which would make this
+        # episode depend on the last. Teleporting away and back clears them.
+        start = env.episode.start
+        env.sim.robot.set_pose(start[0] + 100.0, start[1], start[2])
+        env.sim.robot.set_pose(*start)
+        super().on_reset(env)
+        self.route = plan_route(env.scene, env.episode.start, env.np_random,
+                                self.route_length, self.clearance_margin)
+        self.phase, self.waypoint, self.outbound_steps = OUTBOUND, 1, 0
+
+    def command(self, env: "HomingEnv", v: float, w: float,
+                stopped: bool) -> tuple[float, float, bool]:
+        """Outbound: the env's own pursuit command (normalised); homing: the agent's."""
+        if self.phase == HOMING:
+            return v, w, stopped
+        rc = env.robot_config
+        err = bearing_to(env.pose, self.route[self.waypoint])
+        yaw = float(np.clip(3.0 * err, -self.outbound_yaw_rate, self.outbound_yaw_rate))
+        speed = 0.0 if abs(err) > TURN_FIRST else self.outbound_speed
+        return speed / rc.max_speed, yaw / rc.max_yaw_rate, False
+
+    def step_outcome(self, env: "HomingEnv", collision: bool, stopped: bool):
+        if self.phase == HOMING:
+            return super().step_outcome(env, collision, stopped)
+        self.outbound_steps += 1
+        if math.dist(env.pose[:2], self.route[self.waypoint]) < WAYPOINT_RADIUS:
+            self.waypoint += 1
+            if self.waypoint == len(self.route):
+                self.phase = HOMING
+                self._prev_distance = env.distance_to_goal
+        rewards = {k: 0.0 for k in ("progress", "waypoint", "success", "collision", "time")}
+        return rewards, False, False
+
+    def extra_spaces(self) -> dict[str, spaces.Space]:
+        return {"phase": spaces.Discrete(2)}
+
+    def extra_observation(self, env: "HomingEnv") -> dict[str, np.ndarray]:
+        return {"phase": np.int64(self.phase)}
+
+    def extra_info(self, env: "HomingEnv") -> dict:
+        return {"phase": self.phase, "outbound_steps": self.outbound_steps,
+                "route": self.route.copy()}
