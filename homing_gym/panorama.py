@@ -132,6 +132,15 @@ def random_lighting(rng: np.random.Generator, strength: float) -> Lighting:
 DEFAULT_LIGHTING = Lighting()
 
 
+def photometric(image: np.ndarray, lighting: Lighting | None) -> np.ndarray:
+    """``image`` (uint8) under the global brightness/contrast change of ``lighting``
+    (unchanged for ``None`` or no change)."""
+    if lighting is None or (lighting.contrast == 1 and lighting.brightness == 0):
+        return image
+    offset = 127.5 * (1 - lighting.contrast) + lighting.brightness
+    return cv2.addWeighted(image, lighting.contrast, image, 0.0, offset)
+
+
 @dataclass(frozen=True)
 class ViewGeometry:
     """Size and intrinsics of the perspective views the panorama is resampled from."""
@@ -267,10 +276,7 @@ class PanoramaCamera:
         views = self.render_views(client, pose, lighting or DEFAULT_LIGHTING)
         pano = cv2.remap(views, self._map_x, self._map_y, cv2.INTER_LINEAR,
                          borderMode=cv2.BORDER_REPLICATE)
-        if lighting is not None and (lighting.contrast != 1 or lighting.brightness != 0):
-            offset = 127.5 * (1 - lighting.contrast) + lighting.brightness
-            pano = cv2.addWeighted(pano, lighting.contrast, pano, 0.0, offset)
-        return pano
+        return photometric(pano, lighting)
 
     def omni(self, panorama: np.ndarray) -> np.ndarray:
         """The catadioptric ring image of a panorama: uint8 ``(S, S, 3)``."""

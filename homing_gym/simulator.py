@@ -100,6 +100,8 @@ class Simulator:
 
     def _make_landmark(self, lm: Landmark) -> int:
         position = [lm.position[0], lm.position[1], lm.base + lm.height / 2]
+        if lm.shape == "panel":
+            return self._panel(lm, position)
         if lm.shape == "box":
             half = [lm.extent[0] / 2, lm.extent[1] / 2, lm.height / 2]
             return self._box(half, position, lm.yaw, lm.color, lm.texture)
@@ -107,6 +109,42 @@ class Simulator:
         col = c.createCollisionShape(p.GEOM_CYLINDER, radius=lm.radius, height=lm.height)
         vis = c.createVisualShape(p.GEOM_CYLINDER, radius=lm.radius, length=lm.height,
                                   rgbaColor=list(lm.color))
+        body = c.createMultiBody(0, col, vis, position,
+                                 c.getQuaternionFromEuler([0, 0, lm.yaw]))
+        self._paint(body, lm.color, lm.texture)
+        return body
+
+    def _panel(self, lm: Landmark, position) -> int:
+        """A box whose local +y face carries the whole texture once (u left to right as
+        seen from the front, v bottom to top); the other faces sample the texture's
+        top-left corner."""
+        c = self.client
+        hx, hy, hz = lm.extent[0] / 2, lm.extent[1] / 2, lm.height / 2
+        corner = [0.001, 0.999]
+        vertices, normals, uvs, indices = [], [], [], []
+        for axis in range(3):
+            for sign in (1.0, -1.0):
+                normal = [0.0, 0.0, 0.0]
+                normal[axis] = sign
+                # two axes spanning the face, ordered so the quad winds counter-clockwise
+                a, b = [(1, 2), (2, 0), (0, 1)][axis]
+                face = []
+                for s_a, s_b in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
+                    v = [0.0, 0.0, 0.0]
+                    v[axis] = sign
+                    v[a], v[b] = s_a * sign, s_b
+                    face.append([v[0] * hx, v[1] * hy, v[2] * hz])
+                front = axis == 1 and sign > 0
+                for v in face:
+                    vertices.append(v)
+                    normals.append(normal)
+                    uvs.append([0.5 - v[0] / (2 * hx), 0.5 + v[2] / (2 * hz)] if front
+                               else corner)
+                k = len(vertices) - 4
+                indices += [k, k + 1, k + 2, k, k + 2, k + 3]
+        vis = c.createVisualShape(p.GEOM_MESH, vertices=vertices, indices=indices,
+                                  uvs=uvs, normals=normals, rgbaColor=list(lm.color))
+        col = c.createCollisionShape(p.GEOM_BOX, halfExtents=[hx, hy, hz])
         body = c.createMultiBody(0, col, vis, position,
                                  c.getQuaternionFromEuler([0, 0, lm.yaw]))
         self._paint(body, lm.color, lm.texture)

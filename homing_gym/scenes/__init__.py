@@ -14,6 +14,7 @@ import numpy as np
 
 from homing_gym.scenes.arena import arena_scene
 from homing_gym.scenes.base import SHAPES, Landmark, Scene, Wall, square_walls
+from homing_gym.scenes.corridors import corridors_scene
 from homing_gym.scenes.hallway import hallway_scene
 from homing_gym.scenes.lab import lab_scene
 from homing_gym.scenes.random_arena import random_arena_scene
@@ -54,6 +55,10 @@ def scene_factory(scene: str | Scene) -> SceneFactory:
 register_scene("arena", SceneFactory(
     build=lambda rng: arena_scene(),
     description="Yu & Kim arena: 2.4 m square, four red cylinders"))
+register_scene("corridors", SceneFactory(
+    build=lambda rng: corridors_scene(),
+    description="8 x 6 m: four rooms off a corridor, 12 barcoded self-similar landmarks "
+                "(Briggs et al. 2000)"))
 register_scene("hallway", SceneFactory(
     build=lambda rng: hallway_scene(),
     description="Hong et al. 1991 corridor: 8 x 1.8 m, doors, posters, lamps; has a route"))

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 from homing_gym.textures import check_texture
 
-SHAPES = ("cylinder", "box")
+SHAPES = ("cylinder", "box", "panel")
 
 Color = tuple[float, float, float, float]
 
@@ -33,8 +33,11 @@ class Landmark:
     """A static object: on the floor, or hanging with its bottom ``base`` metres above it
     (posters, lamps).
 
-    ``shape`` is ``"cylinder"`` (uses ``radius``) or ``"box"`` (uses ``extent`` =
-    (length along its yaw, width), metres). ``position`` is the centre of its footprint.
+    ``shape`` is ``"cylinder"`` (uses ``radius``), ``"box"`` (uses ``extent`` =
+    (length along its yaw, width), metres) or ``"panel"``: a box like ``"box"`` whose
+    front face, the one on the left of the yaw direction (local +y), shows ``texture``
+    exactly once, upright and unmirrored (a wall-mounted sign; its other faces take the
+    texture's top-left pixel). ``position`` is the centre of its footprint.
     """
 
     position: tuple[float, float]

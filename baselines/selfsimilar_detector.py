@@ -1,0 +1,434 @@
+"""Detecting self-similar landmarks in any image (Briggs, Scharstein et al. 2000, §3).
+
+The pattern (:mod:`homing_gym.selfsimilar`) is ``p``-similar and ``sqrt(p)``-antisimilar
+along every non-vertical scanline, so its self-similarity origin is where the match
+function of Eq. 7,
+
+    m_y(x) = 1/w sum_xi |I(x+xi, y) - I(x+sqrt(p) xi, y)| - 1/w sum_xi |I(x+xi, y) - I(x+p xi, y)|,
+
+peaks (``xi = 0 .. w-1``, intensities in ``[0, 1]``, in-between pixels by linear
+interpolation, §3). The algorithm:
+
+1. ``m_y`` on every ``k``-th scanline (:func:`match_function`); a *match* is a local
+   maximum above ``c_min`` that is *sharp*: ``m_y(x_m +- delta) < m_y(x_m)/2`` with
+   ``delta ~ w/10`` (§3.1).
+2. Matches on consecutive scanlines (``k`` rows apart, at most ``max_shift * k``
+   columns apart) are chained; each chain of ``>= 3`` gets a least-squares line
+   ``x = a y + b``, the pattern's left edge (§3.2).
+3. The vertical extent: the paper estimates it "from the intensity distribution"
+   without details; we walk along the fitted line row by row, up and down from the
+   outermost matches, while ``m_y`` on the line (best of three columns) stays above
+   half the chain's median peak. The edges lie halfway between the last row that
+   passes and the first that fails.
+4. The barcode (:func:`homing_gym.selfsimilar.barcode_bits`): the pattern's apparent
+   width ``sigma`` is the largest dark-to-bright edge on the middle scanline whose
+   preceding stripe edges keep the ratio ``sqrt(p)`` and which is followed by the white
+   gap (the self-similar pattern alone cannot tell ``sigma`` from ``p sigma``; the
+   narrow gap can).
+   The barcode column is then ``layout.barcode_centre * sigma`` to the right of the
+   origin; its guard bands give its vertical extent (under perspective it differs from
+   the pattern's), and each band is read at its centre. A detection whose guards or
+   parity do not check has ``id = None`` and is dropped when ``require_id``.
+
+§3.3's speed-ups are options: ``coarse_rows`` (every ``2k``-th scanline first, its
+neighbours only where it matched) and ``peak_step = l`` (``m_y`` only at every
+``l``-th pixel; around samples above ``h = c_min/4`` it is evaluated densely).
+
+The result gives each landmark's id, image position, bearing, apparent size and the
+horizontal distance from its apparent height (§4.1) through a camera model
+(:mod:`baselines.camera_models`), so it runs on perspective images and on the
+panorama alike (columns wrap around in a panorama).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from baselines.camera_models import CameraModel
+from homing_gym.geometry import wrap_angle
+from homing_gym.panorama import LUMA
+from homing_gym.selfsimilar import (BARCODE_BANDS, DEFAULT_P, PanelLayout, check_p,
+                                    decode_barcode)
+
+
+@dataclass(frozen=True)
+class DetectorConfig:
+    """Detector parameters (pixels unless named otherwise).
+
+    ``window`` w and ``row_step`` k: the paper's typical values for 640 x 480 are 45 and 6
+    (§3); both depend only on the smallest expected landmark (its pattern must be at least
+    about ``w`` pixels wide and ``3k`` rows tall). ``min_peak`` c_min: the paper gives no
+    number; its full-contrast peaks measure 0.66 (§3.1), ours 0.6 on synthetic scanlines,
+    so 0.2 accepts patterns down to about a third of full contrast. ``sharpness`` gives
+    ``delta = max(1, round(sharpness * w))``: the paper says about w/10, but with the
+    origin between pixels our 2/3-similar peaks are still at 0.55-0.7 of their height
+    at +-w/10 and fall below half only at +-w/7.5 (6 pixels for w = 45), while a
+    3/4-similar wave (Fig. 5d) stays above 0.8 there; hence 0.13. ``coarse_rows`` and
+    ``peak_step`` are §3.3's speed-ups (``peak_step`` 1 = off; the paper suggests 4-5,
+    even 10). ``layout`` is the panel design, known to the robot (pattern height for the
+    distance, barcode position for the id).
+    """
+
+    p: float = DEFAULT_P
+    window: int = 45
+    row_step: int = 6
+    min_peak: float = 0.2
+    sharpness: float = 0.13
+    coarse_rows: bool = False
+    peak_step: int = 1
+    min_group: int = 3
+    max_shift: float = 1.0
+    require_id: bool = True
+    layout: PanelLayout = field(default_factory=PanelLayout)
+
+    def __post_init__(self) -> None:
+        check_p(self.p)
+        for name, low in (("window", 4), ("row_step", 1), ("peak_step", 1), ("min_group", 2)):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, np.integer)) and value >= low):
+                raise ValueError(f"DetectorConfig.{name} must be an integer >= {low}, "
+                                 f"got {value!r}")
+        if not (0 < self.min_peak < 1):
+            raise ValueError(f"DetectorConfig.min_peak must be in (0, 1), got {self.min_peak!r}")
+        if not (0 < self.sharpness < 0.5):
+            raise ValueError(f"DetectorConfig.sharpness must be in (0, 0.5), "
+                             f"got {self.sharpness!r}")
+        if not (self.max_shift >= 0):
+            raise ValueError(f"DetectorConfig.max_shift must be >= 0, got {self.max_shift!r}")
+
+    @property
+    def delta(self) -> int:
+        """Half-height test offset of §3.1 (pixels)."""
+        return max(1, int(round(self.sharpness * self.window)))
+
+
+@dataclass(frozen=True)
+class Detection:
+    """One landmark found in an image (pixel-index coordinates; see
+    :mod:`baselines.camera_models`).
+
+    ``x``, ``y``: the pattern's self-similarity origin (its left edge) on the middle row
+    of the extent; ``top``, ``bottom``: rows of the pattern's edges on that line;
+    ``slope``: ``dx/dy`` of the fitted line; ``width``: apparent pattern width sigma
+    (pixels, on the middle row; ``nan`` if not measured); ``centre_x``: column of the
+    centre of pattern + gap + barcode; ``bearing`` (radians, CCW from the heading) of
+    ``centre_x``; ``distance``: horizontal distance (m) of the pattern's left edge from
+    its apparent height; ``strength``: median peak value of its matches; ``matches``:
+    how many scanlines matched.
+    """
+
+    id: int | None
+    x: float
+    y: float
+    top: float
+    bottom: float
+    slope: float
+    width: float
+    centre_x: float
+    bearing: float
+    distance: float
+    strength: float
+    matches: int
+
+    @property
+    def height(self) -> float:
+        """Apparent pattern height (pixels)."""
+        return self.bottom - self.top
+
+
+def to_gray(image: np.ndarray) -> np.ndarray:
+    """Luminance in ``[0, 1]`` (float32) of a uint8 RGB or grey image."""
+    img = np.asarray(image)
+    if img.ndim == 3:
+        img = img[..., :3].astype(np.float32) @ LUMA
+    return (img / 255.0).astype(np.float32)
+
+
+def _taps(p: float, w: int) -> list[tuple[int, int, float, int, float]]:
+    """For each ``xi`` in ``1 .. w-1``: ``xi``, then floor and fraction of ``sqrt(p) xi``
+    and of ``p xi`` (the interpolation taps of Eq. 7)."""
+    out = []
+    for xi in range(1, w):
+        s, q = math.sqrt(p) * xi, p * xi
+        out.append((xi, int(s), s - int(s), int(q), q - int(q)))
+    return out
+
+
+def match_function(rows: np.ndarray, p: float = DEFAULT_P, w: int = 45,
+                   step: int = 1) -> np.ndarray:
+    """``m_y(x)`` of Eq. 7 for each row of ``rows`` (``(R, n)`` intensities in [0, 1])
+    at ``x = 0, step, 2 step, ...`` up to ``n - w``: ``(R, ceil((n - w + 1)/step))``."""
+    rows = np.atleast_2d(np.asarray(rows, dtype=np.float32))
+    nx = rows.shape[1] - w + 1
+    if nx <= 0:
+        return np.zeros((rows.shape[0], 0), np.float32)
+    acc = np.zeros((rows.shape[0], len(range(0, nx, step))), np.float32)
+    for xi, a, fa, b, fb in _taps(p, w):
+        base = rows[:, xi:xi + nx:step]
+        similar = rows[:, b:b + nx:step] * (1 - fb) + rows[:, b + 1:b + 1 + nx:step] * fb
+        anti = rows[:, a:a + nx:step] * (1 - fa) + rows[:, a + 1:a + 1 + nx:step] * fa
+        acc += np.abs(base - anti) - np.abs(base - similar)
+    return acc / w
+
+
+def match_points(gray: np.ndarray, ys, xs, p: float = DEFAULT_P, w: int = 45) -> np.ndarray:
+    """``m_y(x)`` of Eq. 7 at integer points ``(xs, ys)``; ``-1`` where the window
+    leaves the image."""
+    ys = np.asarray(ys, dtype=np.int64)
+    xs = np.asarray(xs, dtype=np.int64)
+    out = np.full(xs.shape, -1.0, np.float32)
+    ok = (xs >= 0) & (xs + w <= gray.shape[1]) & (ys >= 0) & (ys < gray.shape[0])
+    if not ok.any():
+        return out
+    y, x = ys[ok], xs[ok]
+    acc = np.zeros(x.shape, np.float32)
+    for xi, a, fa, b, fb in _taps(p, w):
+        base = gray[y, x + xi]
+        similar = gray[y, x + b] * (1 - fb) + gray[y, x + b + 1] * fb
+        anti = gray[y, x + a] * (1 - fa) + gray[y, x + a + 1] * fa
+        acc += np.abs(base - anti) - np.abs(base - similar)
+    out[ok] = acc / w
+    return out
+
+
+@dataclass
+class _Match:
+    row: int      # index into the scanline list
+    y: int
+    x: float
+    value: float
+
+
+def _row_matches(gray: np.ndarray, y: int, cfg: DetectorConfig, x_limit: int) -> list[_Match]:
+    """Sharp local maxima above ``c_min`` of ``m_y`` on scanline ``y`` with ``x <
+    x_limit`` (§3.1), with the §3.3 peak scan every ``peak_step`` pixels."""
+    w, l, d = cfg.window, cfg.peak_step, cfg.delta
+    nx = gray.shape[1] - w + 1
+    if nx <= 2:
+        return []
+    values = np.full(nx, np.nan, np.float32)
+    coarse = match_function(gray[y:y + 1], cfg.p, w, l)[0]
+    values[::l] = coarse
+    if l > 1:
+        hits = np.flatnonzero(coarse >= cfg.min_peak / 4) * l
+        if hits.size == 0:
+            return []
+        todo = np.unique((hits[:, None] + np.arange(-l, l + 1)[None, :]).ravel())
+        todo = todo[(todo >= 0) & (todo < nx) & np.isnan(values[np.clip(todo, 0, nx - 1)])]
+        values[todo] = match_points(gray, np.full(todo.shape, y), todo, cfg.p, w)
+    v = np.where(np.isnan(values), -np.inf, values)
+    centre = v[1:-1]
+    peaks = np.flatnonzero((centre >= v[:-2]) & (centre > v[2:])
+                           & (centre > cfg.min_peak)) + 1
+    peaks = peaks[peaks < x_limit]
+    if peaks.size == 0:
+        return []
+    sides = np.concatenate([peaks - d, peaks + d])
+    around = np.full(sides.shape, -np.inf, np.float32)
+    inside = (sides >= 0) & (sides < nx)
+    known = np.zeros(sides.shape, bool)
+    known[inside] = ~np.isnan(values[sides[inside]])
+    around[known] = values[sides[known]]
+    need = inside & ~known
+    around[need] = match_points(gray, np.full(int(need.sum()), y), sides[need], cfg.p, w)
+    left, right = around[:peaks.size], around[peaks.size:]
+    out = []
+    for x, lv, rv in zip(peaks, left, right):
+        value = float(v[x])
+        if lv < value / 2 and rv < value / 2:
+            # sub-pixel position from a parabola through the peak and its neighbours
+            a, b, c = v[x - 1], v[x], v[x + 1]
+            denom = a - 2 * b + c
+            offset = 0.5 * (a - c) / denom if np.isfinite(denom) and denom < 0 else 0.0
+            out.append(_Match(-1, y, float(x + np.clip(offset, -0.5, 0.5)), value))
+    return out
+
+
+def _scan(gray: np.ndarray, cfg: DetectorConfig, x_limit: int) -> list[list[_Match]]:
+    """Matches per scanline ``k/2, k/2 + k, ...``; with ``coarse_rows`` every second
+    scanline first and the others only next to a scanline that matched (§3.3)."""
+    ys = list(range(cfg.row_step // 2, gray.shape[0], cfg.row_step))
+    found: list[list[_Match] | None] = [None] * len(ys)
+    first = range(0, len(ys), 2) if cfg.coarse_rows else range(len(ys))
+    for i in first:
+        found[i] = _row_matches(gray, ys[i], cfg, x_limit)
+    if cfg.coarse_rows:
+        for i in range(1, len(ys), 2):
+            if found[i - 1] or (i + 1 < len(ys) and found[i + 1]):
+                found[i] = _row_matches(gray, ys[i], cfg, x_limit)
+    for i, row in enumerate(found):
+        for m in row or ():
+            m.row = i
+    return [row or [] for row in found]
+
+
+def _chains(rows: list[list[_Match]], cfg: DetectorConfig) -> list[list[_Match]]:
+    """Chains of matches on consecutive scanlines, each match joined to the nearest
+    unclaimed match of the scanline above within ``max_shift * k + 1`` columns."""
+    tol = cfg.max_shift * cfg.row_step + 1
+    chains: list[list[_Match]] = []
+    open_chains: dict[int, list[_Match]] = {}       # id(last match) -> chain
+    previous: list[_Match] = []
+    for row in rows:
+        claimed: set[int] = set()
+        current: dict[int, list[_Match]] = {}
+        for m in row:
+            best = None
+            for q in previous:
+                if id(q) in claimed or abs(q.x - m.x) > tol:
+                    continue
+                if best is None or abs(q.x - m.x) < abs(best.x - m.x):
+                    best = q
+            if best is None:
+                chain = [m]
+                chains.append(chain)
+            else:
+                claimed.add(id(best))
+                chain = open_chains[id(best)]
+                chain.append(m)
+            current[id(m)] = chain
+        open_chains, previous = current, row
+    return [c for c in chains if len(c) >= cfg.min_group]
+
+
+def _interp(gray: np.ndarray, y: int, xs: np.ndarray) -> np.ndarray:
+    """Row ``y`` of ``gray`` at fractional columns ``xs`` (clamped to the image)."""
+    xs = np.clip(xs, 0, gray.shape[1] - 1.001)
+    i = xs.astype(np.int64)
+    f = (xs - i).astype(np.float32)
+    return gray[y, i] * (1 - f) + gray[y, i + 1] * f
+
+
+def _extent(gray: np.ndarray, chain: list[_Match], a: float, b: float,
+            cfg: DetectorConfig) -> tuple[float, float]:
+    """Rows of the pattern's top and bottom edges along the line ``x = a y + b``."""
+    level = 0.5 * float(np.median([m.value for m in chain]))
+
+    def passes(y: int) -> bool:
+        x = int(round(a * y + b))
+        return float(np.max(match_points(gray, [y] * 3, [x - 1, x, x + 1], cfg.p,
+                                         cfg.window))) >= level
+
+    edges = []
+    for start, direction in ((chain[0].y, -1), (chain[-1].y, 1)):
+        y = start
+        for _ in range(2 * cfg.row_step):
+            nxt = y + direction
+            if not (0 <= nxt < gray.shape[0]) or not passes(nxt):
+                break
+            y = nxt
+        edges.append(y + 0.5 * direction)
+    return edges[0], edges[1]
+
+
+def _pattern_width(profile: np.ndarray, lo: float, hi: float, cfg: DetectorConfig,
+                   tolerance: float = 0.07) -> float:
+    """The apparent pattern width sigma (pixels) from the intensity ``profile`` to the
+    right of the origin (sample ``t`` at ``t`` pixels), or ``nan``.
+
+    The stripe edges of ``s_p`` lie at ``sigma p^(n/2)``: consecutive edges have the
+    ratio ``sqrt(p)``, which survives affine and (nearly) perspective distortion. sigma
+    is the largest dark-to-bright edge whose three preceding edges keep that ratio (within
+    ``tolerance``) and after which the profile stays bright for at least half the gap
+    (the next edge of the barcode breaks the ratio: the gap is much narrower than a
+    stripe).
+    """
+    thr = (lo + hi) / 2
+    bright = profile > thr
+    flips = np.flatnonzero(bright[:-1] != bright[1:]) + 1
+    if flips.size < 4:
+        return math.nan
+    # sub-pixel edge positions by linear interpolation between samples f - 1 and f
+    before, after = profile[flips - 1], profile[flips]
+    edges = flips - 1 + (thr - before) / np.where(after != before, after - before, 1e-6)
+    rising = bright[flips]
+    root = math.sqrt(cfg.p)
+    gap = 0.5 * cfg.layout.gap / cfg.layout.pattern_width
+    for j in range(edges.size - 1, 2, -1):
+        sigma = float(edges[j])
+        if sigma < cfg.window / 2:
+            break
+        if not rising[j]:
+            continue
+        ratios = edges[j - 3:j] / edges[j - 2:j + 1]
+        if np.any(np.abs(ratios - root) > tolerance):
+            continue
+        if j + 1 < edges.size and edges[j + 1] < sigma * (1 + gap):
+            continue
+        return sigma
+    return math.nan
+
+
+def _barcode(gray: np.ndarray, x_bar: float, half: float, top: float, bottom: float,
+             thr: float) -> int | None:
+    """Read the barcode column centred on column ``x_bar`` (``half`` pixels either side)
+    between the guard bands found within half a pattern height of ``top``/``bottom``."""
+    h = bottom - top
+    y0, y1 = max(0, int(math.floor(top - 0.5 * h))), min(gray.shape[0], int(math.ceil(bottom + 0.5 * h)))
+    if y1 - y0 < BARCODE_BANDS or not (0 <= x_bar - half and x_bar + half < gray.shape[1] - 1):
+        return None
+    xs = x_bar + np.linspace(-half, half, 3)
+    column = np.array([_interp(gray, y, xs).mean() for y in range(y0, y1)])
+    dark = np.flatnonzero(column < thr)
+    if dark.size == 0:
+        return None
+    start, end = y0 + dark[0] - 0.5, y0 + dark[-1] + 0.5
+    band = (end - start) / BARCODE_BANDS
+    if band < 1.0 or not (0.5 < (end - start) / h < 2.0):
+        return None
+    bands = []
+    for i in range(BARCODE_BANDS):
+        lo = int(round(start + (i + 0.25) * band + 0.5))
+        hi = max(lo + 1, int(round(start + (i + 0.75) * band + 0.5)))
+        bands.append(int(column[lo - y0:hi - y0].mean() < thr))
+    return decode_barcode(bands)
+
+
+def detect_landmarks(image: np.ndarray, model: CameraModel,
+                     config: DetectorConfig = DetectorConfig()) -> list[Detection]:
+    """Every self-similar landmark in ``image`` (uint8 RGB/grey, or float grey in [0, 1])
+    seen through ``model``, strongest first; at most one detection per id."""
+    gray = to_gray(image) if np.asarray(image).dtype == np.uint8 else np.asarray(
+        image, dtype=np.float32)
+    width = gray.shape[1]
+    if model.wraps:  # a panorama: continue each row past its end so patterns may wrap
+        gray = np.concatenate([gray, gray[:, :width // 2]], axis=1)
+    cfg = config
+    found: list[Detection] = []
+    for chain in _chains(_scan(gray, cfg, width), cfg):
+        ys = np.array([m.y for m in chain], dtype=np.float64)
+        xs = np.array([m.x for m in chain], dtype=np.float64)
+        a, b = np.polyfit(ys, xs, 1)
+        top, bottom = _extent(gray, chain, a, b, cfg)
+        y_mid = int(round((top + bottom) / 2 - 0.5))
+        x0 = a * y_mid + b
+        profile = _interp(gray, y_mid, x0 + np.arange(0, gray.shape[1] - x0 - 1))
+        head = profile[:cfg.window]
+        lo, hi = float(np.percentile(head, 5)), float(np.percentile(head, 95))
+        sigma = _pattern_width(profile, lo, hi, cfg)
+        lay = cfg.layout
+        landmark_id = None
+        if math.isfinite(sigma):
+            half = 0.25 * lay.barcode_width / lay.pattern_width * sigma
+            landmark_id = _barcode(gray, x0 + lay.barcode_centre * sigma, half, top, bottom,
+                                   (lo + hi) / 2)
+        if cfg.require_id and landmark_id is None:
+            continue
+        span = (lay.pattern_width + lay.gap + lay.barcode_width) / lay.pattern_width
+        centre = x0 + 0.5 * span * sigma if math.isfinite(sigma) else x0
+        found.append(Detection(
+            id=landmark_id, x=float(x0 % width if model.wraps else x0), y=y_mid + 0.0,
+            top=float(top), bottom=float(bottom), slope=float(a), width=sigma,
+            centre_x=float(centre % width if model.wraps else centre),
+            bearing=wrap_angle(float(model.bearing(centre))),
+            distance=model.distance(x0, top, bottom, lay.pattern_height),
+            strength=float(np.median([m.value for m in chain])), matches=len(chain)))
+    found.sort(key=lambda d: -d.strength * d.matches)
+    unique: list[Detection] = []
+    for det in found:
+        if det.id is None or all(u.id != det.id for u in unique):
+            unique.append(det)
+    return unique
