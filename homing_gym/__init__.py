@@ -16,6 +16,7 @@ _ENVS = {
     "homing_gym/LocalHoming-v0": ("homing_gym.envs:LocalHomingEnv", 500),
     "homing_gym/RouteFollowing-v0": ("homing_gym.envs:RouteFollowingEnv", 1000),
     "homing_gym/LongRangeHoming-v0": ("homing_gym.envs:LongRangeHomingEnv", 2500),
+    "homing_gym/LandmarkNavigation-v0": ("homing_gym.envs:LandmarkNavigationEnv", 3000),
 }
 ENV_IDS: tuple[str, ...] = tuple(_ENVS)
 
@@ -30,7 +31,9 @@ def register_envs() -> None:
 register_envs()
 
 from homing_gym.env import HomingEnv  # noqa: E402
-from homing_gym.envs import LocalHomingEnv, LongRangeHomingEnv, RouteFollowingEnv  # noqa: E402
+from homing_gym.envs import (LandmarkNavigationEnv, LocalHomingEnv,  # noqa: E402
+                             LongRangeHomingEnv, RouteFollowingEnv)
 
-__all__ = ["ENV_IDS", "HomingEnv", "LocalHomingEnv", "LongRangeHomingEnv", "RouteFollowingEnv",
+__all__ = ["ENV_IDS", "HomingEnv", "LandmarkNavigationEnv", "LocalHomingEnv",
+           "LongRangeHomingEnv", "RouteFollowingEnv",
            "register_envs", "__version__"]

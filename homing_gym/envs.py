@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 from homing_gym.env import HomingEnv
+from homing_gym.scenes import SceneFactory, scene_factory
 from homing_gym.scenes.base import Scene
+from homing_gym.scenes.landmark_changes import changed_landmarks
 from homing_gym.tasks import (LocalHomingTask, LongRangeHomingTask, RewardConfig,
                               RouteFollowingTask)
+from homing_gym.tasks.landmark_navigation import LandmarkNavigationTask
 from homing_gym.tasks.route_following import FOOT
 
 
@@ -273,3 +276,104 @@ class LongRangeHomingEnv(HomingEnv):
                                    reward=reward)
         super().__init__(task, scene, obs_keys=obs_keys, **kwargs)
         task.check_limits(self.robot_config)
+
+
+class LandmarkNavigationEnv(HomingEnv):
+    """## Description
+
+    Landmark navigation (Briggs, Scharstein et al. 2000, §4). Barcoded self-similar
+    landmarks hang on the walls of the ``corridors`` scene (four rooms off a corridor, 12
+    panels with ids 0-11; :mod:`homing_gym.selfsimilar`). The goal is a landmark id; the
+    robot must go and stand in front of that landmark, using only what it sees. The
+    robot knows the landmark design (the pattern, the barcode, the panel size), not the
+    map: a method learns where landmarks are by exploring (the paper's visibility graph,
+    controller ``selfsimilar``).
+
+    ## Action space
+
+    As ``LocalHoming-v0``: ``Box(-1, 1, (2,), float32)`` (forward speed, yaw rate; max
+    0.3 m/s and 1.5 rad/s) or ``Discrete(4)`` with ``action_type="discrete"``; control
+    period 0.1 s.
+
+    ## Observation space
+
+    ``Dict`` with the keys in ``obs_keys`` (default ``("panorama", "goal_id")``): every
+    key of ``LocalHoming-v0`` except that ``goal`` is the panorama at the standing pose
+    in front of the goal landmark (a cue a homing method could use, not the paper's),
+    plus:
+
+    | key | space | meaning |
+    |---|---|---|
+    | `goal_id` | `Box(0, 1, (32,), float32)` | one-hot id of the goal landmark (ids 0-31, all a barcode can carry) |
+    | `view` | `Box(0, 255, (h, w, 3), uint8)` | forward perspective camera at the panoramic camera's place: ``view_size`` = (320, 240) pixels, ``view_hfov_deg`` = 60 (Briggs et al. use 320 x 240 and 640 x 480 images) |
+
+    The panorama follows the usual convention (column ``x`` has bearing
+    ``pi - 2*pi*x/W``); landmarks are detectable in it only at high resolution (e.g.
+    ``panorama_shape=(192, 2048)``: the detector needs patterns about 30 pixels wide).
+
+    ## Rewards
+
+    ``progress * (d_prev - d)``, ``d`` the distance (m) to the standing pose ``standoff``
+    = 0.8 m in front of the goal landmark, ``+ success`` on success ``- collision`` per
+    step with contact ``- time`` per step; defaults 1.0, 10.0, 0.1, 0.01
+    (``RewardConfig``). Terms in ``info["rewards"]``.
+
+    ## Starting state
+
+    The goal id is drawn uniformly among the landmarks present; the start uniformly on
+    the floor of the rooms and the corridor (at least 0.25 m from walls and objects, not
+    already in front of the goal), with a uniform heading. With ``remove_landmarks`` =
+    q > 0 each landmark is missing from the episode with probability q (never all); with
+    ``occlude_landmarks`` = q > 0 each remaining one is partly hidden with probability q
+    by a dark board (0.3 m wide, 0.8 m tall) standing 0.3 m in front of it, shifted
+    sideways at random. All drawn from the ``reset(seed=...)`` generator.
+
+    ## Episode end
+
+    *In front of* the goal: robot centre at most ``max_distance`` = 1.2 m from the panel
+    centre, within ``max_angle_deg`` = 30 degrees of the panel's normal as seen from the
+    panel, and the panel within 30 degrees of the robot's heading. With
+    ``success_on="reach"`` (default) the episode terminates, a success, as soon as the
+    robot is in front of the goal; with ``"stop"`` it terminates when the agent issues
+    stop, a success if it is in front of the goal then. Truncated after 3000 steps
+    (300 s).
+
+    ## Info
+
+    As ``LocalHoming-v0`` (``goal_pose`` is the standing pose, ``distance_to_goal`` the
+    distance to it), plus ``goal_id``. Ground truth: for metrics, not for agents.
+
+    ## Arguments
+
+    ``scene`` (default ``"corridors"``; any scene with ``metadata["landmarks"]`` and
+    ``metadata["rooms"]``), ``max_distance``, ``max_angle_deg``, ``standoff``,
+    ``success_on``, ``reward``, ``remove_landmarks`` = 0, ``occlude_landmarks`` = 0
+    (probabilities in [0, 1]), ``view_size``, ``view_hfov_deg``, ``obs_keys``, and every
+    camera and robot argument of ``LocalHoming-v0``.
+
+    ## Version history
+
+    * v0: initial release.
+    """
+
+    def __init__(self, scene: str | Scene = "corridors", *, max_distance: float = 1.2,
+                 max_angle_deg: float = 30.0, standoff: float = 0.8,
+                 success_on: str = "reach", reward: RewardConfig = RewardConfig(),
+                 remove_landmarks: float = 0.0, occlude_landmarks: float = 0.0,
+                 view_size: tuple[int, int] = (320, 240), view_hfov_deg: float = 60.0,
+                 obs_keys: tuple[str, ...] | list[str] = ("panorama", "goal_id"), **kwargs):
+        for name, value in (("remove_landmarks", remove_landmarks),
+                            ("occlude_landmarks", occlude_landmarks)):
+            if not (isinstance(value, (int, float)) and 0 <= value <= 1):
+                raise ValueError(f"{name} must be a probability in [0, 1], got {value!r}")
+        task = LandmarkNavigationTask(max_distance=max_distance, max_angle_deg=max_angle_deg,
+                                      standoff=standoff, success_on=success_on, reward=reward,
+                                      view_size=tuple(view_size), view_hfov_deg=view_hfov_deg)
+        factory = scene_factory(scene)
+        if remove_landmarks > 0 or occlude_landmarks > 0:
+            base = factory
+            factory = SceneFactory(
+                build=lambda rng: changed_landmarks(base.build(rng), rng, remove_landmarks,
+                                                    occlude_landmarks),
+                randomised=True, description=f"{base.description}, landmarks changed")
+        super().__init__(task, factory, obs_keys=obs_keys, **kwargs)

@@ -43,8 +43,11 @@ def available_scenes() -> list[str]:
     return sorted(_SCENES)
 
 
-def scene_factory(scene: str | Scene) -> SceneFactory:
-    """The factory for a scene name, or a fixed factory around a :class:`Scene` object."""
+def scene_factory(scene: "str | Scene | SceneFactory") -> SceneFactory:
+    """The factory for a scene name, or a fixed factory around a :class:`Scene` object
+    (a :class:`SceneFactory` is returned as is)."""
+    if isinstance(scene, SceneFactory):
+        return scene
     if isinstance(scene, Scene):
         return SceneFactory(build=lambda rng, s=scene: s, description=scene.name)
     if scene not in _SCENES:
