@@ -56,28 +56,17 @@ PALETTE: dict[str, BlobColor] = {c.name: c for c in LAB_COLORS}
 
 
 @dataclass
-class BearingController(Controller):
-    """Bearing-only homing from coloured blobs (module docstring). Parameters: ``colors``
-    (names in :data:`PALETTE`, at least 3), ``step_length`` and ``min_step`` (metres),
-    ``gain`` (metres per radian of ``|M|``), ``stop_tol`` (radians), ``min_area``
-    (pixels of a blob). The law is the class's ``law``: ``unified`` here."""
+class BearingLawController(Controller):
+    """What every controller driven by the laws of §2 shares: the step along ``M`` and the
+    unified law's timing (module docstring). ``step_length`` and ``min_step`` (metres),
+    ``gain`` (metres per radian of ``|M|``), ``stop_tol`` (radians)."""
 
-    colors: tuple[str, ...] = ("red", "green", "blue")
     step_length: float = 0.10
     min_step: float = 0.02
     gain: float = 0.3
     stop_tol: float = 0.02
-    min_area: int = 4
-
-    law: ClassVar[str] = "unified"
 
     def validate(self) -> None:
-        if self.law not in LAWS:
-            raise ValueError(f"unknown law {self.law!r}; allowed: {LAWS}")
-        unknown = [c for c in self.colors if c not in PALETTE]
-        if unknown or len(set(self.colors)) < 3 or len(set(self.colors)) != len(self.colors):
-            raise ValueError(f"colors must be at least 3 distinct names from "
-                             f"{sorted(PALETTE)}, got {self.colors!r}")
         if not (math.isfinite(self.min_step) and 0 < self.min_step <= self.step_length):
             raise ValueError(f"need 0 < min_step <= step_length metres, got "
                              f"min_step={self.min_step!r}, step_length={self.step_length!r}")
@@ -87,18 +76,51 @@ class BearingController(Controller):
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"{name} must be a positive number, got {value!r}")
-        if not (isinstance(self.min_area, (int, np.integer)) and self.min_area >= 1):
-            raise ValueError(f"min_area must be an integer >= 1 pixels, got {self.min_area!r}")
-
-    def on_reset(self) -> None:
-        self._unified = UnifiedLaw(self.unified_config())
-        self.last_result: LawResult | None = None
 
     def unified_config(self) -> UnifiedConfig:
         """Algorithm 1's settings at this controller's step length (module docstring)."""
         return UnifiedConfig(dwell=max(1, math.ceil(0.2 / self.min_step)),
                              trend_steps=max(1, math.ceil(0.05 / self.min_step)),
                              stop_tol=self.stop_tol)
+
+    def move_along(self, result: LawResult) -> Move:
+        """The step along the law's motion vector (length ``gain * |M|``, clipped)."""
+        size = float(np.hypot(*result.vector))
+        return Move(result.direction, min(self.step_length, max(self.min_step, self.gain * size)))
+
+    def search_move(self) -> Move:
+        """The move when fewer than three landmarks are matched: straight ahead (the last
+        direction) by ``min_step``, or a quarter turn on the spot before any move."""
+        if self.last_direction is None:
+            return Move(math.pi / 2, 0.0)
+        return Move(0.0, self.min_step)
+
+
+@dataclass
+class BearingController(BearingLawController):
+    """Bearing-only homing from coloured blobs (module docstring). Parameters: ``colors``
+    (names in :data:`PALETTE`, at least 3), ``min_area`` (pixels of a blob) and those of
+    :class:`BearingLawController`. The law is the class's ``law``: ``unified`` here."""
+
+    colors: tuple[str, ...] = ("red", "green", "blue")
+    min_area: int = 4
+
+    law: ClassVar[str] = "unified"
+
+    def validate(self) -> None:
+        super().validate()
+        if self.law not in LAWS:
+            raise ValueError(f"unknown law {self.law!r}; allowed: {LAWS}")
+        unknown = [c for c in self.colors if c not in PALETTE]
+        if unknown or len(set(self.colors)) < 3 or len(set(self.colors)) != len(self.colors):
+            raise ValueError(f"colors must be at least 3 distinct names from "
+                             f"{sorted(PALETTE)}, got {self.colors!r}")
+        if not (isinstance(self.min_area, (int, np.integer)) and self.min_area >= 1):
+            raise ValueError(f"min_area must be an integer >= 1 pixels, got {self.min_area!r}")
+
+    def on_reset(self) -> None:
+        self._unified = UnifiedLaw(self.unified_config())
+        self.last_result: LawResult | None = None
 
     def evaluate(self, current: np.ndarray, goal: np.ndarray) -> LawResult:
         """This controller's law on matched bearings (radians, CCW)."""
@@ -107,17 +129,6 @@ class BearingController(Controller):
         if self.law == "complementary":
             return complementary_law(current, goal)
         return self._unified.step(current, goal)
-
-    def move_along(self, result: LawResult) -> Move:
-        """The step along the law's motion vector (length ``gain * |M|``, clipped)."""
-        size = float(np.hypot(*result.vector))
-        return Move(result.direction, min(self.step_length, max(self.min_step, self.gain * size)))
-
-    def search_move(self) -> Move:
-        """The move when fewer than three landmarks are matched (module docstring)."""
-        if self.last_direction is None:
-            return Move(math.pi / 2, 0.0)
-        return Move(0.0, self.min_step)
 
     def decide(self, observation: dict[str, np.ndarray]) -> Move | None:
         palette = tuple(PALETTE[c] for c in self.colors)

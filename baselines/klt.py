@@ -8,8 +8,8 @@ correspondences between frames are the ids. Each :meth:`CornerTracker.update`
 
 1. tracks every live track from the previous frame into the new one (pyramidal LK,
    ``cv2.calcOpticalFlowPyrLK``) and drops it when LK fails, the forward-backward error
-   exceeds ``fb_threshold`` pixels, or it leaves the image rows (the paper: features that
-   are no longer visible are "dropped");
+   exceeds ``fb_threshold`` pixels, it leaves the image rows, or it has drifted onto an
+   older track (the paper: features that are no longer visible are "dropped");
 2. detects new Shi-Tomasi corners (``cv2.goodFeaturesToTrack``) at least
    ``min_distance`` pixels from the live tracks until ``max_features`` are live, and gives
    each a new id.
@@ -45,7 +45,9 @@ class KLTConfig:
     quality level (fraction of the best corner's score). ``min_distance``: between corners.
     ``block_size``: corner-measure window. ``smoothing_sigma``: Gaussian blur before
     everything (0: none). ``win_size``, ``max_level``: LK window and pyramid levels.
-    ``fb_threshold``: largest forward-backward error kept. ``margin``: seam padding; must
+    ``fb_threshold``: largest forward-backward error kept. ``min_eigen``: LK drops a
+    track whose window's smaller gradient eigenvalue (per pixel, OpenCV's
+    ``minEigThreshold``) falls below this: points sliding along an edge. ``margin``: seam padding; must
     exceed the largest motion between frames plus the LK window.
     """
 
@@ -57,6 +59,7 @@ class KLTConfig:
     win_size: int = 9
     max_level: int = 2
     fb_threshold: float = 0.5
+    min_eigen: float = 1e-3
     margin: int = 24
 
     def __post_init__(self) -> None:
@@ -64,7 +67,7 @@ class KLTConfig:
             raise ValueError(f"max_features must be an integer >= 1, got {self.max_features!r}")
         if not 0 < self.quality < 1:
             raise ValueError(f"quality must be in (0, 1), got {self.quality!r}")
-        for name in ("min_distance", "fb_threshold"):
+        for name in ("min_distance", "fb_threshold", "min_eigen"):
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name} must be > 0 pixels, got {getattr(self, name)!r}")
         if self.smoothing_sigma < 0:
@@ -113,7 +116,8 @@ def track_points(prev: np.ndarray, cur: np.ndarray, points: np.ndarray, config: 
     p0 = np.asarray(points, np.float32).reshape(-1, 1, 2).copy()
     p0[..., 0] = np.mod(p0[..., 0], W) + m
     lk = dict(winSize=(config.win_size, config.win_size), maxLevel=config.max_level,
-              criteria=(cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 30, 0.01))
+              criteria=(cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 30, 0.01),
+              minEigThreshold=config.min_eigen)
     if guess is not None:
         g = np.asarray(guess, np.float32).reshape(-1, 1, 2).copy()
         # the guess in the padded copy nearest to the start point
@@ -169,6 +173,17 @@ def detect_corners(prepared: np.ndarray, config: KLTConfig, count: int,
     return pts
 
 
+def merged(ids: np.ndarray, points: np.ndarray, width: int, radius: float) -> np.ndarray:
+    """Tracks that have drifted within ``radius`` pixels of an older track (smaller id):
+    LK pulls tracks that lost their texture onto a nearby strong corner, where they
+    would be duplicates with wrong identities. Boolean ``(n,)``."""
+    dx = wrap_columns(points[:, None, 0] - points[None, :, 0], width)
+    dy = points[:, None, 1] - points[None, :, 1]
+    close = np.hypot(dx, dy) < radius
+    older = ids[None, :] < ids[:, None]
+    return (close & older).any(axis=1)
+
+
 class CornerTracker:
     """KLT tracking with persistent track ids (see the module docstring)."""
 
@@ -203,6 +218,8 @@ class CornerTracker:
         if self._prev is not None and len(self.ids):
             pts, ok = track_points(self._prev, cur, self.points, self.config)
             self.ids, self.points = self.ids[ok], pts[ok]
+            keep = ~merged(self.ids, self.points, self.width, self.config.min_distance / 2)
+            self.ids, self.points = self.ids[keep], self.points[keep]
         new = detect_corners(cur, self.config, self.config.max_features - len(self.ids),
                              self.points)
         self.ids = np.concatenate([self.ids, self._next_id + np.arange(len(new))])

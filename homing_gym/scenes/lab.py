@@ -1,10 +1,11 @@
 """``lab``: the laboratory of Bekris, Argyros & Kavraki's experiments (§5, Fig. 9).
 
-A 6 m x 5 m room (x in [-3, 3], y in [-2.5, 2.5]) with 1.2 m walls of grey brick and
-concrete. Three distinctly coloured poster columns (red, green, blue; radius 0.1 m,
+A 6 m x 5 m room (x in [-3, 3], y in [-2.5, 2.5]) with 2.5 m walls of grey brick and
+concrete (tall enough that their top edge, which KLT corners would slide along, is
+rarely in view). Three distinctly coloured poster columns (red, green, blue; radius 0.1 m,
 0.7 m high) stand free in the room as the landmarks ``L1``-``L3`` of the bearing-only
 laws; everyday objects give image corners for KLT tracking: a door, a desk, a pile of
-boxes, a bookshelf, a bin and a dark checkered board on the walls.
+boxes, a shelf, a cabinet, a bin and three dark checkered boards on the walls.
 
 The paper's panels were flat posters seen from the workspace; ours are four-sided in
 effect (cylinders), so that the centroid of the blob is the bearing of the column's
@@ -29,7 +30,7 @@ import math
 
 from homing_gym.scenes.base import Landmark, Scene, Wall
 
-HALF_X, HALF_Y, HEIGHT, WALL_T = 3.0, 2.5, 1.2, 0.05
+HALF_X, HALF_Y, HEIGHT, WALL_T = 3.0, 2.5, 2.5, 0.05
 POSTER_RADIUS, POSTER_HEIGHT = 0.1, 0.7
 #: Landmark colours (RGBA) and column positions (m): L1 red, L2 green, L3 blue.
 POSTERS = {"red": ((0.85, 0.08, 0.08, 1.0), (-0.9, -0.6)),
@@ -64,10 +65,16 @@ def lab_scene() -> Scene:
         # a door in the north wall, a board on the west wall, a shelf on the east wall
         _wall_box(-1.2, HALF_Y - 0.03, 0.9, 0.05, 1.1, 0.0, color=(1, 1, 1, 1),
                   texture="wood_light", name="door"),
-        _wall_box(-HALF_X + 0.025, 0.4, 0.9, 0.03, 0.5, 0.15, yaw=math.pi / 2,
+        _wall_box(-HALF_X + 0.025, 0.4, 0.9, 0.03, 0.5, 0.2, yaw=math.pi / 2,
                   color=(1, 1, 1, 1), texture="checker_dark", name="board"),
         _wall_box(HALF_X - 0.16, 0.2, 1.0, 0.3, 0.9, 0.0, yaw=math.pi / 2,
                   color=(0.45, 0.35, 0.3, 1.0), name="shelf"),
+        _wall_box(1.3, HALF_Y - 0.015, 0.8, 0.03, 0.5, 0.3, color=(1, 1, 1, 1),
+                  texture="checker_dark", name="board_north"),
+        _wall_box(1.8, -HALF_Y + 0.015, 0.8, 0.03, 0.5, 0.3, color=(1, 1, 1, 1),
+                  texture="checker_dark", name="board_south"),
+        _wall_box(HALF_X - 0.015, -1.4, 0.7, 0.03, 0.6, 0.25, yaw=math.pi / 2,
+                  color=(1, 1, 1, 1), texture="wood_light", name="cabinet_door"),
         # a desk along the south wall, a pile of boxes in the north-east corner, a bin
         _wall_box(-0.3, -HALF_Y + 0.35, 1.2, 0.6, 0.45, 0.0, color=(1, 1, 1, 1),
                   texture="wood_light", name="desk"),
