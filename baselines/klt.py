@@ -47,8 +47,8 @@ class KLTConfig:
     everything (0: none). ``win_size``, ``max_level``: LK window and pyramid levels.
     ``fb_threshold``: largest forward-backward error kept. ``min_eigen``: LK drops a
     track whose window's smaller gradient eigenvalue (per pixel, OpenCV's
-    ``minEigThreshold``) falls below this: points sliding along an edge. ``margin``: seam padding; must
-    exceed the largest motion between frames plus the LK window.
+    ``minEigThreshold``) falls below this: points sliding along an edge. ``margin``: seam
+    padding; must exceed the largest motion between frames plus the LK window.
     """
 
     max_features: int = 100

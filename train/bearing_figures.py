@@ -14,6 +14,19 @@ table of the fractions.
 
 ``starts`` repeats the unified law's map (coarser grid, no figure) from starts in every
 region and writes ``starts.json`` and a Markdown table: how much depends on ``A``.
+
+    python -m train.bearing_figures fig10 --out docs/bearing
+    python -m train.bearing_figures fig11 --runs 30 --out docs/bearing
+
+From pixels, in PyBullet: the registered controllers ``bearing-basic``,
+``bearing-complementary`` and ``bearing`` (unified) in the ``lab`` scene
+(``LocalHoming-v0``, ``success_on="stop"``). ``fig10`` is the paper's Fig. 10 experiment:
+3 starts in each of ``C^``, ``H^`` and the rest of the plane, goals ``A``, ``C``, ``E``,
+three laws (81 runs); a run is a "Fail" when the law does not stop within the step
+budget or stops more than ``--fail-cm`` from the goal. ``fig11`` is Fig. 11: the unified
+law to each marked position ``A``-``F`` from ``--runs`` seeded random starts; mean and
+standard deviation of the final error. Both write JSON and print Markdown tables beside
+the paper's numbers.
 """
 
 from __future__ import annotations
@@ -186,6 +199,167 @@ def markdown_table(fractions: dict[str, dict[str, float]], first: str = "law") -
     return "\n".join(lines)
 
 
+#: Fig. 10 starts (m) in the lab, by kind of start region (checked with ``region``).
+FIG10_STARTS = {"C": ((0.3, 0.2), (-0.3, -0.3), (0.5, -1.0)),
+                "H": ((-2.3, -2.0), (2.5, -2.0), (0.3, 2.1)),
+                "rest": ((-2.0, 2.0), (2.4, 0.4), (0.9, -2.0))}
+FIG10_GOALS = ("A", "C", "E")
+PIXEL_LAWS = {"basic": "bearing-basic", "complementary": "bearing-complementary",
+              "unified": "bearing"}
+#: The paper's Fig. 10 (cm; None = "Fail"), rows as in FIG10_STARTS, columns
+#: basic A C E, complementary A C E, unified A C E.
+PAPER_FIG10 = [
+    [3.5, 3.0, None, None, None, 4.5, 1.0, 4.5, 5.5],
+    [2.0, 1.0, None, None, None, 5.5, 2.0, 3.5, 8.5],
+    [0.0, 1.5, None, None, None, 4.0, 4.0, 3.0, 3.0],
+    [3.5, 11.5, None, None, None, 6.0, 2.0, 9.0, 1.5],
+    [1.5, 1.5, None, None, None, 2.5, 3.5, 3.0, 6.5],
+    [2.5, 2.0, None, None, None, 8.5, 2.0, 3.0, 3.5],
+    [2.0, 2.0, None, None, None, 2.5, 1.5, 2.0, 2.0],
+    [4.0, 0.0, None, None, None, 9.0, 3.5, 2.0, 5.5],
+    [0.5, 5.5, None, None, None, 3.0, 1.5, 3.5, 8.0]]
+#: The paper's Fig. 11: mean and standard deviation of the final error (cm).
+PAPER_FIG11 = {"A": (1.45, 1.13), "B": (4.65, 2.10), "C": (2.85, 1.41), "D": (2.55, 1.35),
+               "E": (3.22, 1.96), "F": (2.28, 1.22)}
+GOAL_YAW = 0.5
+
+
+def lab_run(env, law: str, start: Sequence[float], goal: str, seed: int = 0) -> dict:
+    """One pixel run of ``law`` (a key of :data:`PIXEL_LAWS`) in the lab from ``start``
+    ``(x, y, yaw)`` to marked position ``goal``: final error (cm), stopped, steps."""
+    import baselines
+    from train.evaluate import prepare_policy, run_episode
+
+    controller = baselines.make(PIXEL_LAWS[law])
+    prepare_policy(controller, env)
+    home = (*env.unwrapped.scene.metadata["marked"][goal], GOAL_YAW)
+    record = run_episode(env, controller, seed, start=start, home=home)
+    return {"law": law, "start": [round(float(v), 3) for v in start], "goal": goal,
+            "error_cm": 100 * record.final_distance, "stopped": record.terminated,
+            "steps": record.steps}
+
+
+def lab_env(max_steps: int):
+    """``LocalHoming-v0`` in the lab, ending when the controller stops."""
+    import gymnasium as gym
+
+    import homing_gym
+
+    gym.register_envs(homing_gym)
+    return gym.make("homing_gym/LocalHoming-v0", scene="lab", success_on="stop",
+                    max_episode_steps=max_steps)
+
+
+def _cell(run: dict, fail_cm: float) -> str:
+    return f"{run['error_cm']:.1f}" if run["stopped"] and run["error_cm"] <= fail_cm \
+        else "Fail"
+
+
+def fig10(out: str, max_steps: int = 800, fail_cm: float = 20.0,
+          progress: bool = True) -> list[dict]:
+    """The Fig. 10 experiment from pixels (module docstring); writes ``fig10.json``."""
+    from baselines.bearing_sim import region
+    from homing_gym.scenes.lab import POSTERS
+
+    triangle = np.array([pos for _, pos in POSTERS.values()])
+    for kind, starts in FIG10_STARTS.items():
+        for start in starts:
+            got = str(region(triangle, np.array(start)))
+            if (kind == "C") != (got in ("T", "C-T")) or (kind != "C" and got != kind):
+                raise ValueError(f"Fig. 10 start {start} lies in {got}, not in {kind}")
+    env = lab_env(max_steps)
+    rng = np.random.default_rng(10)
+    runs = []
+    jobs = [(kind, i, start, law, goal) for kind, starts in FIG10_STARTS.items()
+            for i, start in enumerate(starts) for law in PIXEL_LAWS for goal in FIG10_GOALS]
+    yaws = {start: float(rng.uniform(-np.pi, np.pi)) for starts in FIG10_STARTS.values()
+            for start in starts}
+    for kind, i, start, law, goal in tqdm(jobs, desc="Fig. 10 runs", disable=not progress):
+        run = lab_run(env, law, (*start, yaws[start]), goal)
+        runs.append({"kind": kind, "attempt": i + 1, **run})
+    env.close()
+    os.makedirs(out, exist_ok=True)
+    with open(os.path.join(out, "fig10.json"), "w") as f:
+        json.dump({"max_steps": max_steps, "fail_cm": fail_cm, "goal_yaw": GOAL_YAW,
+                   "runs": runs}, f, indent=1)
+    return runs
+
+
+def fig10_table(runs: list[dict], fail_cm: float = 20.0) -> str:
+    """Markdown: ours and the paper's value in each cell, ``ours / paper``."""
+    cols = [(law, g) for law in PIXEL_LAWS for g in FIG10_GOALS]
+    lines = ["| start | " + " | ".join(f"{law} {g}" for law, g in cols) + " |",
+             "|---|" + "---|" * len(cols)]
+    r = 0
+    for kind, starts in FIG10_STARTS.items():
+        for i, start in enumerate(starts):
+            cells = []
+            for c, (law, goal) in enumerate(cols):
+                run = next(x for x in runs if x["kind"] == kind and x["attempt"] == i + 1
+                           and x["law"] == law and x["goal"] == goal)
+                paper = PAPER_FIG10[r][c]
+                cells.append(f"{_cell(run, fail_cm)} / {'Fail' if paper is None else paper}")
+            lines.append(f"| {REGION_LABELS.get(kind, 'Ĉ')} {i + 1}: {start} | "
+                         + " | ".join(cells) + " |")
+            r += 1
+    return "\n".join(lines)
+
+
+def fig11(out: str, runs: int = 30, max_steps: int = 800, seed: int = 11,
+          progress: bool = True) -> dict[str, dict[str, float]]:
+    """Fig. 11 from pixels: the unified law ``runs`` times to each marked position from
+    seeded random collision-free starts 0.5-3 m away; writes ``fig11.json``."""
+    from homing_gym.scenes.base import clearance
+
+    env = lab_env(max_steps)
+    scene = env.unwrapped.scene
+    rng = np.random.default_rng(seed)
+    (xmin, ymin), (xmax, ymax) = scene.bounds
+    results: dict[str, list[dict]] = {}
+    bar = tqdm(total=runs * len(scene.metadata["marked"]), desc="Fig. 11 runs",
+               disable=not progress)
+    for goal, point in scene.metadata["marked"].items():
+        results[goal] = []
+        while len(results[goal]) < runs:
+            xy = (float(rng.uniform(xmin, xmax)), float(rng.uniform(ymin, ymax)))
+            if clearance(scene, xy) < 0.3 or not 0.5 <= np.hypot(xy[0] - point[0],
+                                                                  xy[1] - point[1]) <= 3.0:
+                continue
+            start = (*xy, float(rng.uniform(-np.pi, np.pi)))
+            results[goal].append(lab_run(env, "unified", start, goal))
+            bar.update()
+    bar.close()
+    env.close()
+    summary = {}
+    for goal, rs in results.items():
+        err = np.array([x["error_cm"] for x in rs])
+        stopped = np.array([x["stopped"] for x in rs])
+        summary[goal] = {"mean_cm": float(err.mean()), "std_cm": float(err.std()),
+                         "median_cm": float(np.median(err)), "stopped": float(stopped.mean())}
+    os.makedirs(out, exist_ok=True)
+    with open(os.path.join(out, "fig11.json"), "w") as f:
+        json.dump({"runs_per_goal": runs, "max_steps": max_steps, "seed": seed,
+                   "summary": summary, "runs": results}, f, indent=1)
+    return summary
+
+
+def fig11_table(summary: dict[str, dict[str, float]]) -> str:
+    """Markdown: mean and std of the final error beside the paper's Fig. 11."""
+    goals = sorted(summary)
+    lines = ["| | " + " | ".join(goals) + " |", "|---|" + "---|" * len(goals),
+             "| mean (cm), ours | " + " | ".join(f"{summary[g]['mean_cm']:.2f}" for g in goals)
+             + " |",
+             "| std (cm), ours | " + " | ".join(f"{summary[g]['std_cm']:.2f}" for g in goals)
+             + " |",
+             "| stopped, ours | " + " | ".join(f"{100 * summary[g]['stopped']:.0f}%"
+                                              for g in goals) + " |",
+             "| mean (cm), paper | " + " | ".join(f"{PAPER_FIG11[g][0]:.2f}" for g in goals)
+             + " |",
+             "| std (cm), paper | " + " | ".join(f"{PAPER_FIG11[g][1]:.2f}" for g in goals)
+             + " |"]
+    return "\n".join(lines)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="bearing-figures", description=__doc__.split("\n")[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -199,8 +373,24 @@ def main(argv: list[str] | None = None) -> int:
     sp.add_argument("--out", default="docs/bearing", help="output folder")
     sp.add_argument("--grid", type=int, default=41, help="grid points per axis")
     sp.add_argument("--no-progress", action="store_true")
+    f10 = sub.add_parser("fig10", help="Fig. 10 from pixels in the lab scene (81 runs)")
+    f10.add_argument("--out", default="docs/bearing", help="output folder")
+    f10.add_argument("--max-steps", type=int, default=800)
+    f10.add_argument("--fail-cm", type=float, default=20.0)
+    f10.add_argument("--no-progress", action="store_true")
+    f11 = sub.add_parser("fig11", help="Fig. 11 from pixels: unified law to marks A-F")
+    f11.add_argument("--out", default="docs/bearing", help="output folder")
+    f11.add_argument("--runs", type=int, default=30, help="runs per marked position")
+    f11.add_argument("--max-steps", type=int, default=800)
+    f11.add_argument("--no-progress", action="store_true")
     args = parser.parse_args(argv)
-    if args.command == "reachability":
+    if args.command == "fig10":
+        runs = fig10(args.out, args.max_steps, args.fail_cm, progress=not args.no_progress)
+        print(fig10_table(runs, args.fail_cm))
+    elif args.command == "fig11":
+        print(fig11_table(fig11(args.out, args.runs, args.max_steps,
+                                progress=not args.no_progress)))
+    elif args.command == "reachability":
         fractions = reachability(args.out, args.grid, args.extent, args.start,
                                  progress=not args.no_progress)
         print(markdown_table(fractions))
