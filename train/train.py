@@ -50,6 +50,7 @@ class TrainConfig:
     n_envs: int = 2
     vec: str = "subproc"
     device: str = "cpu"
+    torch_threads: int = 1
     extractor: str = "panorama"
     features_dim: int = 256
     env_kwargs: dict = field(default_factory=dict)
@@ -65,7 +66,8 @@ class TrainConfig:
             raise ValueError(f"--vec must be 'subproc' or 'dummy', got {self.vec!r}")
         if self.extractor not in EXTRACTORS:
             raise ValueError(f"unknown extractor {self.extractor!r}; allowed: {EXTRACTORS}")
-        for key in ("timesteps", "n_envs", "eval_freq", "eval_episodes", "checkpoint_freq"):
+        for key in ("timesteps", "n_envs", "eval_freq", "eval_episodes", "checkpoint_freq",
+                    "torch_threads"):
             value = getattr(self, key)
             if not (isinstance(value, int) and value >= 1):
                 raise ValueError(f"{key} must be an integer >= 1, got {value!r}")
@@ -203,6 +205,11 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
     from stable_baselines3 import PPO
     from stable_baselines3.common.callbacks import CheckpointCallback, EvalCallback
 
+    import torch
+
+    # One intra-op thread by default: with the env workers on the same cores, torch's
+    # thread pool spins against them and learn() ran 4x slower on 2 cores (docs/training.md).
+    torch.set_num_threads(config.torch_threads)
     out.mkdir(parents=True, exist_ok=True)
     (out / "config.yml").write_text(yaml.safe_dump(asdict(config), sort_keys=False))
     with open(out / "command.txt", "a") as f:
