@@ -3,7 +3,7 @@
 >>> import baselines
 >>> baselines.available()
 ['bearing', 'bearing-basic', 'bearing-complementary', 'distance', 'oracle', 'random',
- 'snapshot', 'warping']
+ 'selfsimilar', 'snapshot', 'warping']
 >>> controller = baselines.make("oracle", step_length=0.2)
 """
 
@@ -19,6 +19,7 @@ from baselines.bearing import (BasicBearingController, BearingController,
 from baselines.distance import DistanceController
 from baselines.oracle import OracleController
 from baselines.random_walk import RandomController
+from baselines.selfsimilar import SelfSimilarController
 from baselines.snapshot import SnapshotController
 from baselines.warping import WarpingController
 
@@ -69,6 +70,7 @@ register("snapshot", SnapshotController)
 register("bearing", BearingController)
 register("bearing-basic", BasicBearingController)
 register("bearing-complementary", ComplementaryBearingController)
+register("selfsimilar", SelfSimilarController)
 
 __all__ = ["Controller", "MotionHelper", "MotionSpec", "Move", "OracleController",
            "RandomController", "available", "controller_class", "make", "parameters",

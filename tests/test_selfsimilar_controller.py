@@ -1,0 +1,144 @@
+"""The ``selfsimilar`` controller (Briggs et al. 2000 §4): registry and bad input, a
+real episode to a visible goal in ``corridors``, and replanning around a removed
+landmark in a small fake world (detections from geometry, exact odometry)."""
+
+import math
+from dataclasses import dataclass, field
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import baselines
+import baselines.selfsimilar as selfsimilar
+from baselines.motion import Move
+from baselines.selfsimilar_detector import Detection
+from baselines.selfsimilar_panel import PanelPose
+from homing_gym.geometry import wrap_angle
+from homing_gym.tasks.landmark_navigation import N_IDS
+from train.evaluate import prepare_policy, run_episode
+
+
+def test_registered_with_its_observation_keys_and_checks_its_parameters():
+    c = baselines.make("selfsimilar", planning="probabilistic")
+    assert isinstance(c, selfsimilar.SelfSimilarController)
+    assert c.observation_keys() == ("view", "goal_id", "odometry")
+    with pytest.raises(ValueError, match="planning 'astar'.*deterministic"):
+        baselines.make("selfsimilar", planning="astar")
+    with pytest.raises(ValueError, match="scan_step_deg"):
+        baselines.make("selfsimilar", scan_step_deg=90.0)
+    with pytest.raises(ValueError, match="standoff"):
+        baselines.make("selfsimilar", standoff=0.0)
+    with pytest.raises(ValueError, match="odometry"):
+        c.decide({"view": np.zeros((240, 320, 3), np.uint8),
+                  "goal_id": np.eye(N_IDS, dtype=np.float32)[0]})
+
+
+def test_reaches_a_visible_goal_and_stops_in_front_of_it():
+    """Corridor, 2 m in front of panel 9 (east end wall), looking 70 degrees away from
+    it: the robot must scan, find it, servo and stop in front of it
+    (``success_on="stop"``: a success only if its own stop is in the success region)."""
+    env = gym.make("homing_gym/LandmarkNavigation-v0", success_on="stop",
+                   obs_keys=("view", "goal_id", "odometry"), max_episode_steps=250)
+    try:
+        env.reset(seed=3)
+        assert env.unwrapped.task.goal_id == 9
+        c = baselines.make("selfsimilar")
+        prepare_policy(c, env)
+        record = run_episode(env, c, seed=3, start=[6.0, 3.0, 1.2])
+    finally:
+        env.close()
+    assert record.success and record.terminated
+    assert record.path_length < 3.0
+
+
+@dataclass
+class FakeWorld:
+    """Landmark panels ``{id: (x, y, normal)}`` seen from in front within ``reach`` m
+    and the field of view; exact motion and odometry."""
+
+    panels: dict[int, tuple[float, float, float]]
+    pose: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    reach: float = 3.1
+    hfov: float = math.radians(60)
+
+    def visible(self, pose) -> dict[int, tuple[float, float]]:
+        """Distance and world angle of each panel visible from ``pose`` (any heading)."""
+        out = {}
+        for i, (x, y, normal) in self.panels.items():
+            dx, dy = x - pose[0], y - pose[1]
+            if math.hypot(dx, dy) <= self.reach and dx * math.cos(normal) + dy * math.sin(
+                    normal) < 0:
+                out[i] = (math.hypot(dx, dy), math.atan2(dy, dx))
+        return out
+
+    def detections(self, *_args) -> list[Detection]:
+        out = []
+        for i, (distance, angle) in self.visible(self.pose).items():
+            bearing = wrap_angle(angle - self.pose[2])
+            if abs(bearing) < self.hfov / 2:
+                out.append(Detection(i, 0, 0, 0, 0, 0, 1.0, 0, bearing, distance, 1.0, 5))
+        return out
+
+    def panel_pose(self, _gray, det: Detection, *_args) -> PanelPose:
+        x, y, normal = self.panels[det.id]
+        c, s = math.cos(self.pose[2]), math.sin(self.pose[2])
+        dx, dy = x - self.pose[0], y - self.pose[1]
+        return PanelPose((c * dx + s * dy, -s * dx + c * dy), wrap_angle(normal - self.pose[2]))
+
+    def move(self, move: Move) -> None:
+        self.pose[2] = wrap_angle(self.pose[2] + move.direction)
+        self.pose[:2] += move.distance * np.array([math.cos(self.pose[2]),
+                                                    math.sin(self.pose[2])])
+
+    def observation(self, goal: int) -> dict[str, np.ndarray]:
+        return {"view": np.zeros((240, 320, 3), np.uint8), "odometry": self.pose.copy(),
+                "goal_id": np.eye(N_IDS, dtype=np.float32)[goal]}
+
+
+#: Panels whose standing places (1 m out) are (0, 0), (2, 0), (1, 1.5) and (3, 1.5).
+#: The goal 2 is out of reach from 0; 0 -> 1 -> 2 (4.7 m) is shorter than 0 -> 3 -> 2.
+PANELS = {0: (-1.0, 0.0, 0.0), 1: (2.0, -1.0, math.pi / 2),
+          3: (1.0, 2.5, -math.pi / 2), 2: (4.0, 1.5, math.pi)}
+
+
+def _standing(i: int) -> tuple[float, float]:
+    x, y, normal = PANELS[i]
+    return x + math.cos(normal), y + math.sin(normal)
+
+
+def _navigate(monkeypatch, removed: set[int], planning: str):
+    """The robot stands at landmark 0 (world origin, facing away from it) with the
+    graph learnt when every landmark was there; those in ``removed`` are gone now.
+    Returns the landmarks it stood at, in order, and the controller."""
+    world = FakeWorld({i: p for i, p in PANELS.items() if i not in removed})
+    monkeypatch.setattr(selfsimilar, "detect_landmarks", world.detections)
+    monkeypatch.setattr(selfsimilar, "panel_pose", world.panel_pose)
+    c = baselines.make("selfsimilar", planning=planning)
+    c.reset(seed=0)
+    everything = FakeWorld(PANELS)
+    for a in (0, 1, 3):
+        c.graph.observe(a, everything.visible(_standing(a)))
+    c.explored.update({0, 1, 3})
+    c.at = 0
+    visited = [0]
+    for _ in range(300):
+        move = c.decide(world.observation(goal=2))
+        if c.at is not None and c.at != visited[-1]:
+            visited.append(c.at)
+        if move is None:
+            break
+        world.move(move)
+    return visited, c, world
+
+
+@pytest.mark.parametrize("planning", ["deterministic", "probabilistic"])
+def test_replans_around_a_removed_landmark(monkeypatch, planning):
+    visited, _, world = _navigate(monkeypatch, set(), planning)
+    assert visited == [0, 1, 2]
+    visited, c, world = _navigate(monkeypatch, {1}, planning)
+    assert visited == [0, 3, 2]
+    assert not c.graph.edge(0, 1).visible and c.graph.edge(0, 1).probability < 1
+    assert math.dist(world.pose[:2], _standing(2)) < 0.15
+    assert c.graph.edge(3, 2).travelled == pytest.approx(
+        math.dist(_standing(3), _standing(2)), abs=0.3)
