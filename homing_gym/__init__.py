@@ -17,6 +17,7 @@ _ENVS = {
     "homing_gym/RouteFollowing-v0": ("homing_gym.envs:RouteFollowingEnv", 1000),
     "homing_gym/LongRangeHoming-v0": ("homing_gym.envs:LongRangeHomingEnv", 2500),
     "homing_gym/LandmarkNavigation-v0": ("homing_gym.envs:LandmarkNavigationEnv", 3000),
+    "homing_gym/WorkLocations-v0": ("homing_gym.envs:WorkLocationsEnv", 1500),
 }
 ENV_IDS: tuple[str, ...] = tuple(_ENVS)
 
@@ -32,8 +33,8 @@ register_envs()
 
 from homing_gym.env import HomingEnv  # noqa: E402
 from homing_gym.envs import (LandmarkNavigationEnv, LocalHomingEnv,  # noqa: E402
-                             LongRangeHomingEnv, RouteFollowingEnv)
+                             LongRangeHomingEnv, RouteFollowingEnv, WorkLocationsEnv)
 
 __all__ = ["ENV_IDS", "HomingEnv", "LandmarkNavigationEnv", "LocalHomingEnv",
-           "LongRangeHomingEnv", "RouteFollowingEnv",
+           "LongRangeHomingEnv", "RouteFollowingEnv", "WorkLocationsEnv",
            "register_envs", "__version__"]

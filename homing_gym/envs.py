@@ -2,14 +2,19 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from homing_gym.env import HomingEnv
 from homing_gym.scenes import SceneFactory, scene_factory
 from homing_gym.scenes.base import Scene
+from homing_gym.scenes.daily_changes import daily_changes as daily_changes_of
 from homing_gym.scenes.landmark_changes import changed_landmarks
 from homing_gym.tasks import (LocalHomingTask, LongRangeHomingTask, RewardConfig,
                               RouteFollowingTask)
 from homing_gym.tasks.landmark_navigation import LandmarkNavigationTask
 from homing_gym.tasks.route_following import FOOT
+from homing_gym.tasks.work_locations import MAX_POINTS, TAUGHT_KEYS, WorkLocationsTask
+from homing_gym.teaching import PLACE_SPACING
 
 
 class LocalHomingEnv(HomingEnv):
@@ -377,3 +382,141 @@ class LandmarkNavigationEnv(HomingEnv):
                                                     occlude_landmarks),
                 randomised=True, description=f"{base.description}, landmarks changed")
         super().__init__(task, factory, obs_keys=obs_keys, **kwargs)
+
+
+class WorkLocationsEnv(HomingEnv):
+    """## Description
+
+    Travel between work locations of a home (Shiraishi & Sawasaki, "multi-resolution
+    image matching", §2-§4). A person taught the robot its *work locations* (including
+    its home) and the *travel paths* between them; now the robot stands at one work
+    location and must travel along the taught path to a named other one and stop there,
+    using only what its camera sees and what it recorded while being taught. Default
+    scene: ``house`` (living room, kitchen, bedroom; work locations ``home``,
+    ``kitchen``, ``bedroom``; see :mod:`homing_gym.scenes.house`). Accuracy of the stop is
+    the point: by default the episode ends when the agent stops (``success_on="stop"``),
+    a success within 0.1 m (the paper: arrival "generally recognized with an accuracy of
+    10 centimeters or better").
+
+    Teaching (:mod:`homing_gym.teaching`), done by the env in the scene as it was on the
+    teaching day, the first time a path is used, and cached: along the path a
+    low-resolution panorama every 0.47 m (§4(1)) and at each corner and the end, each
+    centred on the desired direction of travel; at the target location a
+    *multiresolution feature image map* (§3(2), Fig. 2): its low-resolution panorama
+    (centred on the location's heading), high-resolution templates of up to 10
+    characteristic points (picture centres that the camera sees unoccluded 0.8-6 m away,
+    spread around the horizon) and their positions in the low-resolution panorama, with
+    their 3-D indoor coordinates. The paper's person enters those coordinates by hand;
+    here they are taken from the scene (``metadata["feature_points"]``), exact.
+    Low resolution: grey levels reduced by ``teach_levels`` = 2 steps of a Gaussian
+    pyramid (``cv2.pyrDown``): 16 x 128 for the default 64 x 512 panorama.
+
+    ## Action space
+
+    As ``LocalHoming-v0``: ``Box(-1, 1, (2,), float32)`` (forward speed, yaw rate; max
+    0.3 m/s and 1.5 rad/s; negative speed drives backwards) or ``Discrete(4)`` with
+    ``action_type="discrete"``; control period 0.1 s.
+
+    ## Observation space
+
+    ``Dict`` with the keys in ``obs_keys`` (default: ``panorama`` and every taught key
+    below). ``panorama`` is the current view, default ``panorama_shape`` = (64, 512):
+    0.70 degrees per column, 0.94 per row (the high resolution the templates need). The
+    taught keys are constant during an episode; ``h x w`` is the low-resolution shape,
+    ``t`` = ``template_size``:
+
+    | key | space | meaning |
+    |---|---|---|
+    | `path_panoramas` | `Box(0, 255, (32, h, w), uint8)` | the path's low-resolution grey panoramas in travel order, each centred on the desired direction of travel there (column `w/2`); rows past `path_count` are zero |
+    | `path_count` | `Discrete(33)` | number of taught places on the path; the last is the target location |
+    | `map_panorama` | `Box(0, 255, (h, w), uint8)` | (1-1): low-resolution panorama at the target location, centred on its heading |
+    | `map_templates` | `Box(0, 255, (10, t, t), uint8)` | (1-2): high-resolution grey templates of the characteristic points, each centred on its point |
+    | `map_template_xy` | `Box(0, max(h, w), (10, 2), float32)` | (1-3): continuous (column, row) of each point in `map_panorama` |
+    | `map_points` | `Box(-inf, inf, (10, 3), float32)` | the points' 3-D indoor coordinates (m) |
+    | `map_count` | `Discrete(11)` | number of characteristic points; entries past it are zero |
+    | `map_pose` | `Box(-inf, inf, (3,), float32)` | the target location as taught: (x, y, yaw), m and rad, indoor frame |
+
+    Also every key of ``LocalHoming-v0`` (``goal`` is the panorama at the target
+    location in today's scene). Panorama convention: column ``x`` has bearing
+    ``pi - 2*pi*x/W``, horizon at row ``H/2``; the same holds for the low-resolution
+    images with their own ``w`` and ``h``.
+
+    ## Rewards
+
+    ``progress * (d_prev - d)`` (``d`` the distance in metres to the target location)
+    ``+ success`` once on success ``- collision`` per step with contact ``- time`` per
+    step; defaults 1.0, 10.0, 0.1, 0.01 (``RewardConfig``). Terms in ``info["rewards"]``.
+
+    ## Starting state
+
+    The path (start and target location) is drawn uniformly among the taught paths
+    allowed by ``start_location`` and ``goal_location`` (each a work location name or
+    ``None``: any). The robot stands at the start location perturbed uniformly by up to
+    ``start_jitter`` = (0.05 m, 5 degrees) in x, y and heading. With ``daily_changes`` =
+    s > 0 the scene of each episode is today's house, drawn from the seed: each small
+    object removed with probability s/3 or moved (up to 0.4 m, any yaw) with probability
+    s/2, and round(3 s) new small objects put down at free places, never on a path or a
+    work location (problem (b-1) of §2; :mod:`homing_gym.scenes.daily_changes`); the
+    taught data always shows the house as taught. ``reset(options={"start": pose})``
+    places the robot elsewhere (e.g. 1 m before the target); option ``home`` raises
+    ``ValueError`` (the target is the named location). Everything is reproducible with
+    ``reset(seed=...)``.
+
+    ## Episode end
+
+    ``success_on="stop"`` (default): terminated when the agent issues stop (discrete
+    action 3, or both continuous components below ``stop_threshold`` = 0.05), a success
+    if the robot centre is within ``success_radius`` = 0.1 m of the target location.
+    ``success_on="reach"``: terminated, a success, once within ``success_radius``.
+    Truncated after 1500 steps (150 s).
+
+    ## Info
+
+    As ``LocalHoming-v0`` (``goal_pose`` is the target location), plus
+    ``start_location``, ``goal_location`` (names) and ``places`` (``(K, 3)``: the taught
+    places of the path, x, y and desired direction of travel). Ground truth: for metrics,
+    not for agents.
+
+    ## Arguments
+
+    ``scene`` (default ``"house"``; any scene with ``metadata["work_locations"]``,
+    ``["paths"]`` and ``["feature_points"]``, and for daily changes ``["small_objects"]``
+    and ``["rooms"]``), ``start_location``, ``goal_location``, ``start_jitter``,
+    ``daily_changes`` = 0 (in [0, 1]), ``teach_levels`` = 2 (1-4), ``place_spacing`` =
+    0.47 (m), ``template_size`` = 17 (odd, pixels), ``max_points`` = 10 (2-10),
+    ``success_radius``, ``success_on``, ``reward``, ``obs_keys``, ``panorama_shape`` and
+    every camera and robot argument of ``LocalHoming-v0``. Unknown location names, a
+    path with more than 32 places, or values out of range raise ``ValueError``.
+
+    ## Version history
+
+    * v0: initial release.
+    """
+
+    def __init__(self, scene: str | Scene = "house", *, start_location: str | None = None,
+                 goal_location: str | None = None,
+                 start_jitter: tuple[float, float] = (0.05, 0.0873),
+                 daily_changes: float = 0.0, teach_levels: int = 2,
+                 place_spacing: float = PLACE_SPACING, template_size: int = 17,
+                 max_points: int = MAX_POINTS, success_radius: float = 0.1,
+                 success_on: str = "stop", reward: RewardConfig = RewardConfig(),
+                 panorama_shape: tuple[int, int] = (64, 512),
+                 obs_keys: tuple[str, ...] | list[str] = ("panorama", *TAUGHT_KEYS),
+                 **kwargs):
+        if not (isinstance(daily_changes, (int, float)) and 0 <= daily_changes <= 1):
+            raise ValueError(f"daily_changes must be in [0, 1] (0: the house as taught), "
+                             f"got {daily_changes!r}")
+        task = WorkLocationsTask(tuple(panorama_shape), start_location, goal_location,
+                                 start_jitter=start_jitter, teach_levels=teach_levels,
+                                 spacing=place_spacing, template_size=template_size,
+                                 max_points=max_points, success_radius=success_radius,
+                                 success_on=success_on, reward=reward)
+        factory = scene_factory(scene)
+        task.taught_scene = factory.build(np.random.default_rng(0))
+        if daily_changes > 0:
+            base = factory
+            factory = SceneFactory(
+                build=lambda rng: daily_changes_of(base.build(rng), rng, daily_changes),
+                randomised=True, description=f"{base.description}, daily changes")
+        super().__init__(task, factory, panorama_shape=panorama_shape, obs_keys=obs_keys,
+                         **kwargs)

@@ -16,6 +16,7 @@ from homing_gym.scenes.arena import arena_scene
 from homing_gym.scenes.base import SHAPES, Landmark, Scene, Wall, square_walls
 from homing_gym.scenes.corridors import corridors_scene
 from homing_gym.scenes.hallway import hallway_scene
+from homing_gym.scenes.house import house_scene
 from homing_gym.scenes.lab import lab_scene
 from homing_gym.scenes.random_arena import random_arena_scene
 
@@ -65,6 +66,10 @@ register_scene("corridors", SceneFactory(
 register_scene("hallway", SceneFactory(
     build=lambda rng: hallway_scene(),
     description="Hong et al. 1991 corridor: 8 x 1.8 m, doors, posters, lamps; has a route"))
+register_scene("house", SceneFactory(
+    build=lambda rng: house_scene(),
+    description="8 x 6 m home: living room, kitchen, bedroom, furniture, pictures; "
+                "work locations and travel paths (Shiraishi & Sawasaki)"))
 register_scene("lab", SceneFactory(
     build=lambda rng: lab_scene(),
     description="Bekris et al. Fig. 9 lab: 6 x 5 m, three coloured poster columns, "

@@ -6,8 +6,9 @@ from homing_gym.tasks.landmark_navigation import LandmarkNavigationTask
 from homing_gym.tasks.local_homing import LocalHomingTask
 from homing_gym.tasks.long_range import LongRangeHomingTask
 from homing_gym.tasks.route_following import RouteFollowingTask
+from homing_gym.tasks.work_locations import WorkLocationsTask
 
 __all__ = ["SUCCESS_MODES", "Episode", "GoalReachingTask", "LandmarkNavigationTask",
            "LocalHomingTask",
            "LongRangeHomingTask", "RewardConfig",
-           "RouteFollowingTask", "Task", "sample_free_pose"]
+           "RouteFollowingTask", "Task", "WorkLocationsTask", "sample_free_pose"]
