@@ -1,0 +1,200 @@
+"""Image matching of Shiraishi & Sawasaki's multi-resolution scheme, as pure functions.
+
+* :func:`front_view` and :func:`match_heading`: §3(1): the front image reduced to low
+  resolution is correlated (normalised correlation, ``cv2.TM_CCOEFF_NORMED``) with a
+  stored low-resolution panorama at every horizontal offset (the panorama wraps); the
+  offset of the best match from the panorama's centre, converted to an angle, is the
+  deviation of the camera's heading from the direction the panorama was centred on.
+  :func:`locate_on_path` takes the best of a path's panoramas as the current place.
+* :func:`arrival_scores`: §3(1) "work location arrival decision", Fig. 5: a rectangle
+  clipped from the centre of the front image is enlarged or reduced through several
+  levels, brought to the stored panoramas' resolution and compared with the target's
+  panorama; the best scale says whether the robot is short of (enlarged best), past
+  (reduced best) or at the work location.
+* :func:`find_template`: §3(2) (2-3): a high-resolution template searched by
+  normalised correlation only in a small window around its predicted position, with a
+  sub-pixel peak.
+* :func:`triangulate`: §3(2): position and heading from the known 3-D coordinates of
+  two or more rediscovered points and their apparent directions (bearing and elevation;
+  with the camera height known, two points fix the pose), by Gauss-Newton least squares.
+
+Image coordinates are continuous: column ``x`` in ``[0, W)`` with bearing
+``pi - 2*pi*x/W`` (radians, CCW from the heading), pixel ``j`` covering ``[j, j + 1)``;
+rows likewise, elevation ``vfov/2 - vfov*y/H``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from homing_gym.geometry import wrap_angle
+from homing_gym.panorama import column_bearing
+
+
+def _wrap_pad(image: np.ndarray, pad: int) -> np.ndarray:
+    """``image`` with ``pad`` columns of its other end on each side (it is a panorama)."""
+    return np.concatenate([image[:, -pad:], image, image[:, :pad]], axis=1)
+
+
+def _subpixel(scores: np.ndarray, i: int) -> float:
+    """Parabolic refinement of the peak at index ``i`` of a 1-D score array (offset in
+    ``[-0.5, 0.5]``, 0 at the borders)."""
+    if i <= 0 or i >= len(scores) - 1:
+        return 0.0
+    a, b, c = float(scores[i - 1]), float(scores[i]), float(scores[i + 1])
+    den = a - 2 * b + c
+    return 0.0 if den >= 0 else float(np.clip(0.5 * (a - c) / den, -0.5, 0.5))
+
+
+def front_view(panorama: np.ndarray, fov: float) -> np.ndarray:
+    """The central ``fov`` radians of columns of a panorama (the camera's front image):
+    an even number of columns centred on column ``W/2``, all rows."""
+    w = panorama.shape[1]
+    n = max(2, 2 * int(round(fov / (2 * math.pi) * w / 2)))
+    return panorama[:, w // 2 - n // 2:w // 2 + n // 2]
+
+
+def match_heading(front: np.ndarray, panorama: np.ndarray) -> tuple[float, float]:
+    """Where ``front`` (a front view, same height as ``panorama``) fits in ``panorama``
+    (grey): ``(deviation, score)``. ``deviation`` (radians, CCW) is the bearing, in the
+    panorama's frame, of the centre of ``front``: the camera's heading relative to the
+    direction the panorama is centred on. ``score``: the normalised correlation."""
+    h, n = front.shape[:2]
+    if panorama.shape[0] != h or n >= panorama.shape[1]:
+        raise ValueError(f"front view {front.shape} must have the panorama's height and "
+                         f"fewer columns than it, panorama {panorama.shape}")
+    w = panorama.shape[1]
+    padded = _wrap_pad(panorama, n)
+    scores = cv2.matchTemplate(padded.astype(np.float32), front.astype(np.float32),
+                               cv2.TM_CCOEFF_NORMED)[0]
+    i = int(np.argmax(scores))
+    column = i + _subpixel(scores, i) + n / 2 - n
+    return wrap_angle(column_bearing(column, w)), float(scores[i])
+
+
+def locate_on_path(front: np.ndarray, panoramas) -> tuple[int, float, float]:
+    """The place whose panorama matches ``front`` best: ``(index, deviation, score)``
+    (:func:`match_heading` for each)."""
+    if len(panoramas) == 0:
+        raise ValueError("no stored panoramas to match against")
+    matches = [match_heading(front, p) for p in panoramas]
+    k = int(np.argmax([s for _, s in matches]))
+    return k, matches[k][0], matches[k][1]
+
+
+def arrival_scores(panorama: np.ndarray, target: np.ndarray, scales, fov: float,
+                   levels: int, shift: int = 2) -> np.ndarray:
+    """Normalised correlation of the current full-resolution grey ``panorama``'s front,
+    enlarged by each of ``scales`` about the image centre (ahead, on the horizon), with
+    the target's low-resolution panorama ``target`` (``levels`` pyramid steps smaller).
+
+    The compared rectangle is the central ``fov`` radians and the central half of the
+    rows of ``target``; for scale ``s`` the current image's rectangle ``1/s`` times as
+    large is resampled to it (``cv2.resize``, area averaging). The best of horizontal
+    shifts up to ``shift`` low-resolution columns is taken (residual heading error)."""
+    H, W = panorama.shape[:2]
+    h, w = target.shape[:2]
+    k = 2 ** levels
+    half_w = max(1, int(round(fov / (2 * math.pi) * w / 2)))
+    half_h = max(1, h // 4)
+    ref = target[h // 2 - half_h:h // 2 + half_h,
+                 w // 2 - half_w - shift:w // 2 + half_w + shift].astype(np.float32)
+    out = []
+    for s in scales:
+        if not (0.5 <= s <= 2.0):
+            raise ValueError(f"arrival scales must lie in [0.5, 2], got {s!r}")
+        cw, ch = half_w * k / s, half_h * k / s
+        patch = cv2.getRectSubPix(_wrap_pad(panorama, W // 2),
+                                  (int(round(2 * cw)), int(round(2 * ch))),
+                                  (W / 2 - 0.5 + W // 2, H / 2 - 0.5))
+        small = cv2.resize(patch, (2 * half_w, 2 * half_h), interpolation=cv2.INTER_AREA)
+        scores = cv2.matchTemplate(ref, small.astype(np.float32), cv2.TM_CCOEFF_NORMED)
+        out.append(float(scores.max()))
+    return np.array(out)
+
+
+@dataclass(frozen=True)
+class TemplateMatch:
+    """A rediscovered characteristic point: continuous ``(x, y)`` of the template's
+    centre in the searched image and the normalised correlation ``score``."""
+
+    x: float
+    y: float
+    score: float
+
+
+def find_template(image: np.ndarray, template: np.ndarray, x: float, y: float,
+                  radius: tuple[int, int]) -> TemplateMatch | None:
+    """Search grey ``template`` (odd size) in the grey panorama ``image`` with its centre
+    within ``radius = (columns, rows)`` of the continuous point ``(x, y)`` (columns
+    wrap). ``None`` if the window leaves the image's rows."""
+    t = template.shape[0]
+    H, W = image.shape[:2]
+    rx, ry = radius
+    r = t // 2
+    cx, cy = int(math.floor(x)), int(math.floor(y))
+    top, bottom = cy - ry - r, cy + ry + r + 1
+    if top < 0 or bottom > H:
+        return None
+    pad = rx + r + 1
+    left = cx - rx - r + pad
+    window = _wrap_pad(image, pad)[top:bottom, left:left + 2 * rx + t]
+    scores = cv2.matchTemplate(window.astype(np.float32), template.astype(np.float32),
+                               cv2.TM_CCOEFF_NORMED)
+    j, i = np.unravel_index(int(np.argmax(scores)), scores.shape)
+    dx = _subpixel(scores[j, :], i)
+    dy = _subpixel(scores[:, i], j)
+    return TemplateMatch(x=float((cx - rx + i + dx + 0.5) % W), y=float(cy - ry + j + dy + 0.5),
+                         score=float(scores[j, i]))
+
+
+def _predicted(pose, points: np.ndarray, camera_height: float) -> np.ndarray:
+    dx, dy = points[:, 0] - pose[0], points[:, 1] - pose[1]
+    dist = np.hypot(dx, dy)
+    return np.concatenate([wrap_angle(np.arctan2(dy, dx) - pose[2]),
+                           np.arctan2(points[:, 2] - camera_height, dist)])
+
+
+def predicted_directions(pose, points, camera_height: float) -> tuple[np.ndarray, np.ndarray]:
+    """Bearings and elevations (radians) of 3-D ``points`` ``(N, 3)`` seen from a camera
+    at ``pose`` (x, y, yaw), ``camera_height`` metres above the floor."""
+    pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    both = _predicted(np.asarray(pose, dtype=np.float64), pts, camera_height)
+    return both[:len(pts)], both[len(pts):]
+
+
+def triangulate(points, bearings, elevations, camera_height: float, guess,
+                iterations: int = 30, tolerance: float = 1e-12) -> np.ndarray:
+    """The camera pose ``(x, y, yaw)`` (metres, radians) that best explains the observed
+    ``bearings`` and ``elevations`` (radians) of known 3-D ``points`` ``(N, 3)``, N >= 2:
+    Gauss-Newton on the angle residuals (numerical Jacobian) from ``guess``."""
+    pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    if len(pts) < 2 or len(bearings) != len(pts) or len(elevations) != len(pts):
+        raise ValueError(f"triangulation needs at least 2 points with one bearing and one "
+                         f"elevation each, got {len(pts)} points, {len(bearings)} bearings, "
+                         f"{len(elevations)} elevations")
+    observed = np.concatenate([bearings, elevations]).astype(np.float64)
+    pose = np.asarray(guess, dtype=np.float64).copy()
+
+    def residual(q):
+        r = _predicted(q, pts, camera_height) - observed
+        r[:len(pts)] = wrap_angle(r[:len(pts)])
+        return r
+
+    for _ in range(iterations):
+        r = residual(pose)
+        jac = np.empty((len(r), 3))
+        for k in range(3):
+            dq = np.zeros(3)
+            dq[k] = 1e-7
+            jac[:, k] = (residual(pose + dq) - residual(pose - dq)) / 2e-7
+        step = np.linalg.lstsq(jac, -r, rcond=None)[0]
+        pose += step
+        if float(step @ step) < tolerance:
+            break
+    pose[2] = wrap_angle(pose[2])
+    return pose
