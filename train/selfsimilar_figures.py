@@ -1,12 +1,23 @@
 """Measurements for the self-similar landmarks of Briggs, Scharstein et al. 2000 (issue 8).
 
     python -m train.selfsimilar_figures speed --out docs/selfsimilar
+    python -m train.selfsimilar_figures detection --out docs/selfsimilar
 
 ``speed``: detector frame rate on one core at 640 x 480 and 320 x 240 (the paper's
 sizes), with and without the §3.3 speed-ups (every 2k-th scanline first; peak scan
 every l-th pixel), on rendered views of the ``corridors`` scene: one with a landmark at
 2 m straight on and one of a bare wall. Writes ``speed.json`` under ``--out`` and prints
 a Markdown table beside the paper's 36 and 81 frames/s (450 MHz Pentium II).
+
+``detection``: recall and false positives per image of the detector as the
+``selfsimilar`` controller runs it (320 x 240, 60 degrees, w = 22, k = 3) on rendered
+views of one panel (id 5) on a wall: over distance (1-5 m) and viewing angle (0-60
+degrees off the panel's normal, camera pointed at the panel centre, then turned by
+-5, 0 and +5 degrees), over contrast (1, 0.5, 0.25) and over partial occlusion (a dark
+board just in front of the panel hiding the left 10, 25 or 50 % of the pattern, from
+the self-similarity origin on). A hit: id 5 among the detections; a false positive:
+any other detection. Writes ``detection.json`` and ``detection.png`` under ``--out``
+and prints Markdown tables.
 """
 
 from __future__ import annotations
@@ -86,16 +97,154 @@ def speed_table(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
+#: The detector as the controller runs it on its 320 x 240 view.
+VIEW_SIZE, VIEW_HFOV = (320, 240), math.radians(60)
+VIEW_DETECTOR = DetectorConfig(window=22, row_step=3)
+DISTANCES = (1.0, 2.0, 3.0, 4.0, 5.0)
+ANGLES = (0, 15, 30, 45, 60)
+TURNS = (-5, 0, 5)
+CONTRASTS = (1.0, 0.5, 0.25)
+OCCLUSIONS = (0.0, 0.1, 0.25, 0.5)
+PANEL_ID, PANEL_X = 5, 3.0
+
+
+def _one_panel_env(contrast: float, occluded: float):
+    """LocalHoming-v0 in a 6 m room with panel 5 centred on the wall x = 3 (facing -x),
+    of ``contrast``, the left ``occluded`` fraction of its pattern hidden by a board."""
+    import gymnasium as gym
+
+    import homing_gym
+    from homing_gym.scenes.base import Landmark, Scene, square_walls
+    from homing_gym.scenes.corridors import wall_panel
+    from homing_gym.selfsimilar import PanelLayout
+
+    gym.register_envs(homing_gym)
+    lay = PanelLayout()
+    landmarks = [wall_panel(PANEL_ID, PANEL_X, 0.0, math.pi, contrast=contrast)]
+    if occluded > 0:
+        # as seen from the room the pattern's left edge is at y = width/2 - margin
+        y_hi = lay.width / 2
+        y_lo = lay.width / 2 - lay.margin - occluded * lay.pattern_width
+        landmarks.append(Landmark((PANEL_X - 0.06, (y_hi + y_lo) / 2), shape="box",
+                                  extent=(y_hi - y_lo, 0.02), height=0.7,
+                                  yaw=math.pi / 2, color=(0.25, 0.25, 0.27, 1.0),
+                                  name="occluder"))
+    scene = Scene("one_panel", ((-3, -3), (3, 3)), walls=square_walls(6.0, height=1.2),
+                  landmarks=tuple(landmarks))
+    env = gym.make("homing_gym/LocalHoming-v0", scene=scene, start_distance=(0.3, 1.0))
+    env.reset(seed=0)
+    return env
+
+
+def _viewpoints(distance: float, angle_deg: float):
+    """Poses ``distance`` m from the panel centre, ``angle_deg`` off its normal, facing
+    the centre and then turned by each of ``TURNS`` degrees."""
+    a = math.radians(angle_deg)
+    x, y = PANEL_X - distance * math.cos(a), distance * math.sin(a)
+    facing = math.atan2(-y, PANEL_X - x)
+    return [np.array([x, y, facing + math.radians(t)]) for t in TURNS]
+
+
+def measure_detection() -> list[dict]:
+    """One row per condition: images, hits, false positives."""
+    from baselines.camera_models import PerspectiveModel
+
+    model = PerspectiveModel.from_fov(*VIEW_SIZE, VIEW_HFOV)
+    grids = [(1.0, 0.0, DISTANCES, ANGLES)]
+    grids += [(c, 0.0, (2.0, 4.0), (0, 30, 60)) for c in CONTRASTS[1:]]
+    grids += [(1.0, f, (2.0, 4.0), (0, 30, 60)) for f in OCCLUSIONS[1:]]
+    rows = []
+    for contrast, occluded, distances, angles in grids:
+        env = _one_panel_env(contrast, occluded)
+        try:
+            for d in distances:
+                for a in angles:
+                    hits = false = 0
+                    for pose in _viewpoints(d, a):
+                        image = env.unwrapped.render_view(pose, size=VIEW_SIZE,
+                                                          hfov_deg=math.degrees(VIEW_HFOV))
+                        ids = [x.id for x in detect_landmarks(image, model, VIEW_DETECTOR)]
+                        hits += PANEL_ID in ids
+                        false += sum(i != PANEL_ID for i in ids)
+                    rows.append({"contrast": contrast, "occluded": occluded, "distance": d,
+                                 "angle": a, "images": len(TURNS), "hits": hits,
+                                 "false_positives": false})
+        finally:
+            env.close()
+    return rows
+
+
+def detection_tables(rows: list[dict]) -> str:
+    """Recall (hits / images) tables: distance x angle at full contrast; contrast and
+    occlusion at 2 and 4 m; and false positives per image overall."""
+    def cell(sel):
+        n = sum(r["images"] for r in sel)
+        return f"{sum(r['hits'] for r in sel)}/{n}" if n else ""
+
+    out = ["Recall, full contrast, no occlusion (hits/images):", "",
+           "| distance (m) | " + " | ".join(f"{a} deg" for a in ANGLES) + " |",
+           "|---|" + "---:|" * len(ANGLES)]
+    base = [r for r in rows if r["contrast"] == 1.0 and r["occluded"] == 0.0]
+    for d in DISTANCES:
+        out.append(f"| {d:g} | " + " | ".join(
+            cell([r for r in base if r["distance"] == d and r["angle"] == a])
+            for a in ANGLES) + " |")
+    out += ["", "Recall at 2 m / 4 m, over 0, 30 and 60 deg:", "",
+            "| condition | 2 m | 4 m |", "|---|---:|---:|"]
+    for c in CONTRASTS:
+        sel = [r for r in rows if r["contrast"] == c and r["occluded"] == 0.0
+               and r["angle"] in (0, 30, 60)]
+        out.append(f"| contrast {c:g} | " + " | ".join(
+            cell([r for r in sel if r["distance"] == d]) for d in (2.0, 4.0)) + " |")
+    for f in OCCLUSIONS[1:]:
+        sel = [r for r in rows if r["occluded"] == f]
+        out.append(f"| {f:.0%} of the pattern occluded | " + " | ".join(
+            cell([r for r in sel if r["distance"] == d]) for d in (2.0, 4.0)) + " |")
+    images = sum(r["images"] for r in rows)
+    false = sum(r["false_positives"] for r in rows)
+    out += ["", f"False positives: {false} in {images} images "
+                f"({false / images:.3f} per image)."]
+    return "\n".join(out)
+
+
+def detection_figure(rows: list[dict], path: str) -> None:
+    """Recall over distance, one line per viewing angle (full contrast, no occlusion)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5, 3.2))
+    for a in ANGLES:
+        sel = [r for r in rows if r["contrast"] == 1.0 and r["occluded"] == 0.0
+               and r["angle"] == a]
+        ax.plot([r["distance"] for r in sel], [r["hits"] / r["images"] for r in sel],
+                marker="o", label=f"{a} deg")
+    ax.set(xlabel="distance to the panel centre (m)", ylabel="recall", ylim=(-0.05, 1.05),
+           title="Detection in the 320 x 240 view (w = 22, k = 3)")
+    ax.legend(title="off the normal", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m train.selfsimilar_figures",
                                      description=__doc__.split("\n")[0])
-    parser.add_argument("what", choices=["speed"])
+    parser.add_argument("what", choices=["speed", "detection"])
     parser.add_argument("--out", default="docs/selfsimilar")
     parser.add_argument("--repeats", type=int, default=20)
     args = parser.parse_args(argv)
     if args.repeats < 1:
         parser.error(f"--repeats must be >= 1, got {args.repeats}")
     os.makedirs(args.out, exist_ok=True)
+    if args.what == "detection":
+        rows = measure_detection()
+        with open(os.path.join(args.out, "detection.json"), "w") as f:
+            json.dump(rows, f, indent=1)
+        detection_figure(rows, os.path.join(args.out, "detection.png"))
+        print(detection_tables(rows))
+        return 0
     rows = measure_speed(args.repeats)
     with open(os.path.join(args.out, "speed.json"), "w") as f:
         json.dump(rows, f, indent=1)
