@@ -102,7 +102,8 @@ class LocalHomingEnv(HomingEnv):
     (0-1: strength of an illumination change between the home snapshot and the run, drawn
     from the seed: light direction, brightness, contrast),
     ``start_distance``, ``success_radius``, ``success_on``, ``reward`` (a
-    ``RewardConfig``), ``max_episode_steps``.
+    ``RewardConfig``, or a dict of some of its fields, e.g. ``{"progress": 10.0}``),
+    ``max_episode_steps``.
 
     ## Version history
 

@@ -29,6 +29,9 @@ ENV = "homing_gym/LocalHoming-v0"
     ({"odometry_noise": -1.0}, ["odometry_noise"]),
     ({"max_speed": math.nan}, ["max_speed"]),
     ({"physics_substeps": 0}, ["physics_substeps"]),
+    ({"reward": {"progres": 10.0}}, ["progres", "progress", "collision"]),
+    ({"reward": {"success": math.inf}}, ["success", "inf"]),
+    ({"reward": 10.0}, ["reward", "10.0"]),
 ])
 def test_bad_kwargs(kwargs, words):
     with pytest.raises(ValueError) as err:
@@ -82,3 +85,13 @@ def test_unknown_shape_texture_and_degenerate_wall():
         Landmark(position=(0, 0), texture="marble")
     with pytest.raises(ValueError, match="length"):
         Wall((0, 0), (0, 0))
+
+
+def test_reward_weights_from_a_mapping_scale_the_progress_term(make_env):
+    env = make_env(reward={"progress": 10.0, "time": 0.0})
+    env.reset(seed=0)
+    start = env.unwrapped.distance_to_goal
+    _, reward, _, _, info = env.step(np.array([1.0, 0.0], np.float32))
+    moved = start - env.unwrapped.distance_to_goal
+    assert info["rewards"]["progress"] == pytest.approx(10.0 * moved)
+    assert info["rewards"]["time"] == 0.0

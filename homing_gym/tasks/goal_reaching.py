@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING
 
 from homing_gym.tasks.base import Task
@@ -28,6 +29,27 @@ class RewardConfig:
     collision: float = 0.1
     time: float = 0.01
 
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value)):
+                raise ValueError(f"reward weight {f.name} must be a finite number, got {value!r}")
+
+    @classmethod
+    def from_value(cls, value: "RewardConfig | Mapping[str, float]") -> "RewardConfig":
+        """A ``RewardConfig`` from itself or from a mapping of some of its fields (as
+        YAML or JSON env kwargs give it, e.g. ``{"progress": 10}``)."""
+        if isinstance(value, cls):
+            return value
+        if not isinstance(value, Mapping):
+            raise ValueError(f"reward must be a RewardConfig or a mapping of its fields, "
+                             f"got {value!r}")
+        allowed = [f.name for f in fields(cls)]
+        unknown = sorted(set(value) - set(allowed))
+        if unknown:
+            raise ValueError(f"unknown reward terms {unknown}; allowed: {allowed}")
+        return cls(**value)
+
 
 class GoalReachingTask(Task):
     """Visit the episode's goals in order (``Episode.goals``: waypoints, then home).
@@ -42,7 +64,7 @@ class GoalReachingTask(Task):
     """
 
     def __init__(self, success_radius: float = 0.15, success_on: str = "reach",
-                 reward: RewardConfig = RewardConfig()):
+                 reward: RewardConfig | Mapping[str, float] = RewardConfig()):
         if not (math.isfinite(success_radius) and success_radius > 0):
             raise ValueError(f"success_radius must be a positive number of metres, "
                              f"got {success_radius!r}")
@@ -50,7 +72,7 @@ class GoalReachingTask(Task):
             raise ValueError(f"unknown success_on {success_on!r}; allowed: {SUCCESS_MODES}")
         self.success_radius = float(success_radius)
         self.success_on = success_on
-        self.reward = reward
+        self.reward = RewardConfig.from_value(reward)
         self.goal_errors: list[float] = []
         self._prev_distance = 0.0
 
