@@ -2,8 +2,8 @@
 
 >>> import baselines
 >>> baselines.available()
-['bearing', 'bearing-basic', 'bearing-complementary', 'distance', 'oracle', 'random',
- 'selfsimilar', 'snapshot', 'warping']
+['bearing', 'bearing-basic', 'bearing-complementary', 'distance', 'multires', 'oracle',
+ 'random', 'selfsimilar', 'snapshot', 'warping']
 >>> controller = baselines.make("oracle", step_length=0.2)
 """
 
@@ -17,6 +17,7 @@ from baselines.motion import MotionHelper, MotionSpec, Move
 from baselines.bearing import (BasicBearingController, BearingController,
                                ComplementaryBearingController)
 from baselines.distance import DistanceController
+from baselines.multires import MultiResController
 from baselines.oracle import OracleController
 from baselines.random_walk import RandomController
 from baselines.selfsimilar import SelfSimilarController
@@ -71,6 +72,7 @@ register("bearing", BearingController)
 register("bearing-basic", BasicBearingController)
 register("bearing-complementary", ComplementaryBearingController)
 register("selfsimilar", SelfSimilarController)
+register("multires", MultiResController)
 
 __all__ = ["Controller", "MotionHelper", "MotionSpec", "Move", "OracleController",
            "RandomController", "available", "controller_class", "make", "parameters",

@@ -51,10 +51,11 @@ def _subpixel(scores: np.ndarray, i: int) -> float:
 
 
 def front_view(panorama: np.ndarray, fov: float) -> np.ndarray:
-    """The central ``fov`` radians of columns of a panorama (the camera's front image):
-    an even number of columns centred on column ``W/2``, all rows."""
+    """The central ``fov`` radians (at most ``2*pi``: the whole panorama) of columns of a
+    panorama (the camera's front image): an even number of columns centred on column
+    ``W/2``, all rows."""
     w = panorama.shape[1]
-    n = max(2, 2 * int(round(fov / (2 * math.pi) * w / 2)))
+    n = min(max(2, 2 * int(round(fov / (2 * math.pi) * w / 2))), 2 * (w // 2))
     return panorama[:, w // 2 - n // 2:w // 2 + n // 2]
 
 
@@ -64,9 +65,9 @@ def match_heading(front: np.ndarray, panorama: np.ndarray) -> tuple[float, float
     panorama's frame, of the centre of ``front``: the camera's heading relative to the
     direction the panorama is centred on. ``score``: the normalised correlation."""
     h, n = front.shape[:2]
-    if panorama.shape[0] != h or n >= panorama.shape[1]:
+    if panorama.shape[0] != h or n > panorama.shape[1]:
         raise ValueError(f"front view {front.shape} must have the panorama's height and "
-                         f"fewer columns than it, panorama {panorama.shape}")
+                         f"at most its columns, panorama {panorama.shape}")
     w = panorama.shape[1]
     padded = _wrap_pad(panorama, n)
     scores = cv2.matchTemplate(padded.astype(np.float32), front.astype(np.float32),

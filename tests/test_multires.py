@@ -57,3 +57,30 @@ def test_template_found_at_its_subpixel_position_only_inside_the_window():
     assert abs(match.x - 200.3) < 0.25 and abs(match.y - 30.6) < 0.25
     assert find_template(image, template, 300.0, 33.0, (8, 5)).score < 0.7
     assert find_template(image, template, 200.0, 3.0, (8, 5)) is None
+
+
+@pytest.mark.parametrize("goal, start", [("kitchen", (5.5, 4.55, 0.1)),
+                                         ("bedroom", (5.6, 1.45, -0.15))])
+def test_controller_stops_within_10_cm_of_a_work_location_from_1_m_away(make_env, goal, start):
+    import baselines
+    from train.evaluate import prepare_policy, run_episode
+
+    env = make_env("homing_gym/WorkLocations-v0", goal_location=goal, max_episode_steps=200)
+    controller = baselines.make("multires")
+    prepare_policy(controller, env)
+    record = run_episode(env, controller, seed=0, start=start)
+    assert record.terminated and record.success
+    assert record.final_distance < 0.10
+    assert record.collisions == 0
+
+
+def test_controller_refuses_discrete_actions_and_bad_parameters():
+    import baselines
+    from baselines.motion import MotionSpec
+
+    with pytest.raises(ValueError, match="continuous"):
+        baselines.make("multires").configure(MotionSpec(action_type="discrete"))
+    with pytest.raises(ValueError, match="scales"):
+        baselines.make("multires", scales=(0.9, 1.1))
+    with pytest.raises(ValueError, match="step_length"):
+        baselines.make("multires", step_length=0.0)

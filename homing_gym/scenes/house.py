@@ -64,8 +64,8 @@ def _route(a: str, b: str) -> tuple[tuple[float, float], ...]:
 
 PATHS = {(a, b): _route(a, b) for a in WORK_LOCATIONS for b in WORK_LOCATIONS if a != b}
 
-#: Pictures: (name, x, y on the wall face, normal into the room in degrees, texture,
-#: width, height, centre height), metres.
+#: Pictures: (name, x, y on the wall (or furniture) face, normal into the room in
+#: degrees, texture, width, height, centre height), metres.
 PICTURES = (
     ("picture_west_n", 0.0, 3.9, 0, "poster_a", 0.6, 0.45, 0.7),
     ("picture_west_s", 0.0, 2.1, 0, "poster_b", 0.5, 0.4, 0.65),
@@ -80,6 +80,11 @@ PICTURES = (
     ("picture_bedroom_e", 8.0, 2.7, 180, "checker_green", 0.4, 0.35, 0.9),
     ("picture_bedroom_w", 4.55, 0.5, 0, "stripes_cool", 0.5, 0.4, 0.65),
     ("picture_bedroom_n", 7.3, 2.95, -90, "poster_a", 0.5, 0.4, 0.75),
+    # pictures stuck on furniture: the fridge, a cupboard door, the wardrobe, the desk
+    ("picture_fridge", 7.25, 5.6, 180, "checker_green", 0.3, 0.3, 0.6),
+    ("picture_cupboard", 7.4, 3.95, 180, "stripes_cool", 0.4, 0.3, 0.5),
+    ("picture_wardrobe", 7.4, 1.05, 180, "stripes_warm", 0.35, 0.3, 0.5),
+    ("picture_desk", 5.5, 0.55, 90, "checker_dark", 0.4, 0.3, 0.45),
 )
 
 
