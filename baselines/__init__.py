@@ -2,8 +2,8 @@
 
 >>> import baselines
 >>> baselines.available()
-['bearing', 'bearing-basic', 'bearing-complementary', 'distance', 'multires', 'oracle',
- 'random', 'selfsimilar', 'snapshot', 'warping']
+['bearing', 'bearing-basic', 'bearing-complementary', 'bearing-longrange', 'distance',
+ 'multires', 'oracle', 'random', 'selfsimilar', 'snapshot', 'warping']
 >>> controller = baselines.make("oracle", step_length=0.2)
 """
 
@@ -16,6 +16,7 @@ from baselines.base import Controller
 from baselines.motion import MotionHelper, MotionSpec, Move
 from baselines.bearing import (BasicBearingController, BearingController,
                                ComplementaryBearingController)
+from baselines.bearing_longrange import LongRangeBearingController
 from baselines.distance import DistanceController
 from baselines.multires import MultiResController
 from baselines.oracle import OracleController
@@ -71,6 +72,7 @@ register("snapshot", SnapshotController)
 register("bearing", BearingController)
 register("bearing-basic", BasicBearingController)
 register("bearing-complementary", ComplementaryBearingController)
+register("bearing-longrange", LongRangeBearingController)
 register("selfsimilar", SelfSimilarController)
 register("multires", MultiResController)
 

@@ -17,9 +17,12 @@ Every decision (:meth:`BearingController.decide`):
 Choices where the paper is open (also in ``docs/bearing.md``):
 
 * **Step length.** The paper's robot follows ``M`` continuously ("updated over time").
-  We move ``gain * |M|`` metres (``|M|`` in radians, Eq. 1), clipped to
-  ``[min_step, step_length]`` = [0.02, 0.10] m, then decide again: full steps far away,
-  short ones near the goal, where ``|M|`` tends to 0.
+  We move ``gain * |M| * 3 / P`` metres (``|M|`` in radians, Eq. 1; ``P`` the number of
+  landmark pairs summed, 3 for three landmarks), clipped to ``[min_step, step_length]`` =
+  [0.02, 0.10] m, then decide again: full steps far away, short ones near the goal, where
+  ``|M|`` tends to 0. Dividing by ``P / 3`` keeps the step of three landmarks and makes it
+  independent of the number of features (``|M|`` sums ``N(N-1)/2`` pairs: 3160 for 80
+  KLT corners, where an unscaled step would always be the longest and overshoot).
 * **Stop tolerance.** ``stop_tol`` = 0.02 rad (1.15 deg) on every separation. §6 puts the
   accuracy of a separation at 0.027 rad for a 1394-pixel panorama and 3 pixels of
   feature error; our default panorama is 256 columns (1.41 deg each) but the blob
@@ -84,8 +87,9 @@ class BearingLawController(Controller):
                              stop_tol=self.stop_tol)
 
     def move_along(self, result: LawResult) -> Move:
-        """The step along the law's motion vector (length ``gain * |M|``, clipped)."""
-        size = float(np.hypot(*result.vector))
+        """The step along the law's motion vector (length ``gain * |M| * 3 / P``, clipped;
+        ``P`` pairs)."""
+        size = float(np.hypot(*result.vector)) * 3 / len(result.pairs)
         return Move(result.direction, min(self.step_length, max(self.min_step, self.gain * size)))
 
     def search_move(self) -> Move:

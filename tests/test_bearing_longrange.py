@@ -1,0 +1,79 @@
+"""``bearing-longrange`` (Bekris, Argyros & Kavraki §3, Fig. 5): milestones from the
+features' life cycles, the median realignment, and homing from pixels in
+LongRangeHoming-v0."""
+
+import math
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import baselines
+from baselines.bearing_longrange import birth_frames, choose_milestones, median_offset
+from baselines.klt import KLTConfig
+from train.evaluate import prepare_policy, run_episode
+
+
+def test_milestones_are_the_earliest_frames_sharing_enough_features():
+    # Fig. 5 in small: life cycles 0: frames 0-2, 1: 0-4, 2: 1-6, 3: 2-6, 4: 3-6, 5: 5-6
+    alive = {0: (0, 2), 1: (0, 4), 2: (1, 6), 3: (2, 6), 4: (3, 6), 5: (5, 6)}
+    frames = [np.array([i for i, (b, e) in alive.items() if b <= t <= e]) for t in range(7)]
+    assert birth_frames(frames) == {i: b for i, (b, _) in alive.items()}
+    # from G = 6: features 2, 3, 4 (born 1, 2, 3) are shared back to frame 3; frame 3
+    # holds 1-4, of which 1, 2, 3 reach back to frame 2; frame 2 holds 0-3, of which 0,
+    # 1, 2 reach back to frame 1; frame 1 shares only 0 and 1 with frame 0.
+    assert choose_milestones(frames, 3) == [3, 2, 1, 0]
+    assert choose_milestones(frames, 2) == [2, 0]
+    # asking for more than a frame holds: step back one frame at a time
+    assert choose_milestones(frames, 5) == [5, 4, 3, 2, 1, 0]
+    assert choose_milestones(frames[:1], 3) == []
+    with pytest.raises(ValueError, match="empty"):
+        choose_milestones([], 3)
+
+
+def test_median_offset_is_robust_and_does_not_split_at_pi():
+    # -0.02, +0.01, +0.03 around pi: the median is pi + 0.01 (a plain median of the
+    # wrapped values would give -pi + 0.03)
+    offsets = np.array([math.pi - 0.02, -math.pi + 0.01, -math.pi + 0.03])
+    assert median_offset(offsets) == pytest.approx(-math.pi + 0.01)
+    assert median_offset(np.array([0.1, 0.11, 0.12, 0.13, 2.0])) == pytest.approx(0.12)
+    with pytest.raises(ValueError, match="at least one"):
+        median_offset(np.zeros(0))
+
+
+def test_longrange_homes_from_pixels_and_turns_to_the_home_heading():
+    env = gym.make("homing_gym/LongRangeHoming-v0", route_length=3.0, success_on="stop",
+                   max_episode_steps=900)
+    try:
+        controller = baselines.make("bearing-longrange")
+        prepare_policy(controller, env)
+        record = run_episode(env, controller, seed=0)
+        outbound = env.unwrapped.task.outbound_steps
+    finally:
+        env.close()
+    assert not controller.needs_env
+    assert len(controller.memory) == outbound + 1          # every frame, then G
+    assert controller.milestones[-1] == 0 and len(controller.milestones) >= 3
+    assert record.success and record.terminated               # stopped within 0.2 m
+    assert record.final_distance < 0.1
+    assert record.final_heading_error_deg < 15.0
+    assert record.collisions == 0
+
+
+@pytest.mark.parametrize("params, match", [
+    ({"min_shared": 2}, "min_shared"),
+    ({"min_shared": 101}, "min_shared"),
+    ({"min_shared": 20, "klt": KLTConfig(max_features=10)}, "min_shared"),
+    ({"inlier_fraction": 0.0}, "inlier_fraction"),
+    ({"klt": {"max_features": 100}}, "KLTConfig"),
+    ({"stop_tol": -1.0}, "stop_tol"),
+])
+def test_bad_parameters_raise(params, match):
+    with pytest.raises(ValueError, match=match):
+        baselines.make("bearing-longrange", **params)
+
+
+def test_missing_phase_key_raises():
+    controller = baselines.make("bearing-longrange")
+    with pytest.raises(ValueError, match="phase"):
+        controller.predict({"panorama": np.zeros((64, 256, 3), np.uint8)})
