@@ -10,15 +10,15 @@ SHIPPED = shipped_policies()
 
 def test_a_policy_is_shipped_with_its_config_and_curve():
     assert SHIPPED, "train/shipped/ holds no policy"
-    for name, (model, _) in SHIPPED.items():
-        assert model.stat().st_size < 10 * 2**20, name
-        assert model.with_suffix(".yml").is_file(), name
-        assert model.with_name(f"{name}_curve.png").is_file(), name
+    for name, shipped in SHIPPED.items():
+        assert shipped.path.stat().st_size < 10 * 2**20, name
+        assert shipped.path.with_suffix(".yml").is_file(), name
+        assert shipped.path.with_name(f"{name}_curve.png").is_file(), name
 
 
 @pytest.mark.parametrize("name", sorted(SHIPPED))
 def test_shipped_policy_reaches_home_in_half_of_10_episodes(name):
-    model, env_kwargs = SHIPPED[name]
-    result = evaluate(str(model), DEFAULT_ENV, episodes=10, seed=0, env_kwargs=env_kwargs,
-                      workers=1)
+    shipped = SHIPPED[name]
+    result = evaluate(str(shipped.path), DEFAULT_ENV, episodes=10, seed=0,
+                      env_kwargs=shipped.env_kwargs, params=shipped.params, workers=1)
     assert sum(r.success for r in result.episodes) >= 5, result.summary

@@ -143,9 +143,40 @@ def test_ship_copies_the_best_model_with_eval_settings_and_curve(tmp_path):
     assert target.read_bytes() == b"best"
     meta = yaml.safe_load((shipped / "p.yml").read_text())
     assert meta["eval_env_kwargs"] == {"action_type": "discrete"}
+    assert meta["eval_params"] == {"deterministic": True}
     assert meta["timesteps"] == 1000 and meta["commands"] == ["homing-train --seed 3"]
     assert (shipped / "p_curve.png").read_bytes() == b"png"
-    assert ship_run(run, "q", shipped, final=True).read_bytes() == b"final"
+    assert ship_run(run, "q", shipped, final=True, stochastic=True).read_bytes() == b"final"
+    assert yaml.safe_load((shipped / "q.yml").read_text())["eval_params"] == {
+        "deterministic": False}
     (run / "summary.json").unlink()
     with pytest.raises(ValueError, match="summary.json"):
         ship_run(run, "r", shipped)
+
+
+def test_stochastic_evaluation_of_a_model_is_reproducible_per_episode(tmp_path):
+    import gymnasium as gym
+    from stable_baselines3 import PPO
+
+    from train.evaluate import evaluate
+    from train.extractor import policy_kwargs_for
+
+    kwargs = {"panorama_shape": [16, 64], "max_episode_steps": 12, "action_type": "discrete"}
+    env = gym.make("homing_gym/LocalHoming-v0", **kwargs)
+    PPO("MultiInputPolicy", env, n_steps=16, batch_size=16, n_epochs=1, seed=0,
+        policy_kwargs=policy_kwargs_for("panorama", features_dim=16)).save(tmp_path / "m.zip")
+    env.close()
+
+    def paths(**params):
+        result = evaluate(str(tmp_path / "m.zip"), episodes=2, seed=5, env_kwargs=kwargs,
+                          params=params, progress=False)
+        assert result.params["deterministic"] == params.get("deterministic", True)
+        return [np.asarray(r.trajectory) for r in result.episodes]
+
+    first, again = paths(deterministic=False), paths(deterministic=False)
+    assert all(np.array_equal(a, b) for a, b in zip(first, again))
+    modes = paths()
+    assert not all(np.array_equal(a, b) for a, b in zip(first, modes))
+    with pytest.raises(ValueError, match="deterministic"):
+        evaluate(str(tmp_path / "m.zip"), episodes=1, env_kwargs=kwargs,
+                 params={"deterministic": "maybe"})

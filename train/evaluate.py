@@ -206,8 +206,7 @@ def run_episode(env: gym.Env, policy, seed: int, start: Sequence[float] | None =
     steps, done, info = 0, False, {"is_success": False, "collisions": 0}
     terminated = truncated = False
     while not done:
-        action, state = policy.predict(obs, state=state, episode_start=episode_start,
-                                       deterministic=True)
+        action, state = policy.predict(obs, state=state, episode_start=episode_start)
         episode_start = False
         obs, _, terminated, truncated, info = env.step(action)
         steps += 1
@@ -329,7 +328,8 @@ def add_policy_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--policy", required=True,
                         help="registered controller name or path to a stable-baselines3 .zip")
     parser.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
-                        help="controller parameter override (repeatable)")
+                        help="controller parameter override (repeatable); for an SB3 model "
+                        "only deterministic=false (sample actions, seeded per episode)")
     parser.add_argument("--env", default=DEFAULT_ENV, help="env id")
     parser.add_argument("--env-kwargs", default=None, metavar="JSON",
                         help="keyword arguments of gym.make, a JSON object")

@@ -19,6 +19,8 @@ from gymnasium import spaces
 import baselines
 from baselines import Controller
 
+SB3_PARAMS: dict[str, Any] = {"deterministic": True}   # parameters of SB3 models, defaults
+
 
 @dataclass
 class PolicySpec:
@@ -40,7 +42,7 @@ class PolicySpec:
     def build(self):
         """A fresh live policy (in the calling process)."""
         if self.kind == "sb3":
-            return SB3Policy(self.source)
+            return SB3Policy(self.source, **self.params)
         if self.instance is not None:
             return dataclasses.replace(self.instance)
         return baselines.make(self.source, **self.params)
@@ -48,7 +50,8 @@ class PolicySpec:
     def resolved_params(self) -> dict[str, Any]:
         """All parameter values of a controller (defaults included); the path for SB3."""
         if self.kind == "sb3":
-            return {"path": os.path.abspath(self.source)}
+            return {"path": os.path.abspath(self.source),
+                    "deterministic": self.params.get("deterministic", True)}
         return (self.instance if self.instance is not None else self.build()).params()
 
 
@@ -72,9 +75,14 @@ def policy_spec(policy: str | Controller | PolicySpec,
     if policy.endswith(".zip") or os.path.exists(policy):
         if not os.path.isfile(policy):
             raise ValueError(f"model file {policy!r} does not exist")
-        if params:
-            raise ValueError("--param applies to scripted controllers, not to SB3 models")
-        return PolicySpec("sb3", policy)
+        unknown = sorted(set(params) - set(SB3_PARAMS))
+        if unknown:
+            raise ValueError(f"SB3 models take the parameters {list(SB3_PARAMS)}, "
+                             f"not {unknown}")
+        if not isinstance(params.get("deterministic", True), bool):
+            raise ValueError(f"deterministic must be true or false, got "
+                             f"{params['deterministic']!r}")
+        return PolicySpec("sb3", policy, params)
     raise ValueError(f"unknown policy {policy!r}: not a registered controller "
                      f"{baselines.available()} nor a stable-baselines3 model .zip file")
 
@@ -101,13 +109,17 @@ def _coerce(text: str, default: Any, key: str) -> Any:
 
 
 def parse_params(items: list[str] | None, controller: str) -> dict[str, Any]:
-    """``["key=value", ...]`` -> typed parameter overrides for ``controller``."""
+    """``["key=value", ...]`` -> typed parameter overrides for ``controller`` (a registered
+    name, or an SB3 model path: then only :data:`SB3_PARAMS`)."""
     if not items:
         return {}
-    if controller not in baselines.available():
-        raise ValueError("--param applies to registered controllers only "
-                         f"{baselines.available()}")
-    defaults = baselines.parameters(controller)
+    if controller in baselines.available():
+        defaults = baselines.parameters(controller)
+    elif controller.endswith(".zip"):
+        defaults = SB3_PARAMS
+    else:
+        raise ValueError("--param applies to registered controllers "
+                         f"{baselines.available()} and SB3 model .zip files")
     out: dict[str, Any] = {}
     for item in items:
         key, sep, value = item.partition("=")
@@ -134,12 +146,18 @@ def _spaces_match(model_space, env_space) -> bool:
 
 
 class SB3Policy:
-    """A stable-baselines3 PPO model behind the harness' policy interface."""
+    """A stable-baselines3 PPO model behind the harness' policy interface.
 
-    def __init__(self, path: str):
+    ``deterministic=True`` (default) acts with the mode of the action distribution;
+    ``False`` samples from it, with torch's generator seeded by the episode seed at each
+    :meth:`reset`, so a stochastic evaluation is reproducible episode by episode, whichever
+    worker runs it."""
+
+    def __init__(self, path: str, deterministic: bool = True):
         from stable_baselines3 import PPO  # heavy import: only when a model is evaluated
 
         self.path = path
+        self.deterministic = bool(deterministic)
         self.model = PPO.load(path, device="cpu")
 
     def check_env(self, env) -> None:
@@ -152,9 +170,15 @@ class SB3Policy:
                                  f"action_type, panorama_shape)")
 
     def reset(self, seed: int | None = None) -> None:
-        """SB3 policies keep no episode memory outside ``state``."""
+        """No episode memory outside ``state``; seeds the action sampling."""
+        if seed is not None and not self.deterministic:
+            import torch
 
-    def predict(self, observation, state=None, episode_start=None, deterministic=True):
+            torch.manual_seed(seed)
+
+    def predict(self, observation, state=None, episode_start=None, deterministic=None):
+        """The model's action; ``deterministic=None`` uses the policy's own setting."""
         start = None if episode_start is None else np.atleast_1d(episode_start)
+        mode = self.deterministic if deterministic is None else deterministic
         return self.model.predict(observation, state=state, episode_start=start,
-                                  deterministic=deterministic)
+                                  deterministic=mode)

@@ -6,7 +6,8 @@ writes ``train/shipped/<name>.zip`` (the run's ``best_model.zip``, chosen by the
 evaluation on held-out training seeds, or ``model.zip`` with ``--final``),
 ``<name>.yml`` (the run's config, command, timesteps and wall time, and the
 ``eval_env_kwargs`` that ``homing-suite`` evaluates it with: the training env kwargs
-without the training ``scene``, so the policy is scored in the env's default scene) and
+without the training ``scene``, so the policy is scored in the env's default scene; and
+``eval_params``: ``deterministic``, false with ``--stochastic``) and
 ``<name>_curve.png`` (the run's learning curve).
 """
 
@@ -24,8 +25,11 @@ from train.suite import POLICY_DIR
 MAX_BYTES = 10 * 2**20
 
 
-def ship_run(run: Path, name: str, folder: Path = POLICY_DIR, final: bool = False) -> Path:
-    """Copy run ``run`` into ``folder`` as ``name``; returns the shipped zip's path."""
+def ship_run(run: Path, name: str, folder: Path = POLICY_DIR, final: bool = False,
+             stochastic: bool = False) -> Path:
+    """Copy run ``run`` into ``folder`` as ``name``; returns the shipped zip's path.
+    ``stochastic``: evaluate it by sampling actions (``eval_params: {deterministic:
+    false}``) instead of taking the distribution's mode."""
     model = run / ("model.zip" if final else "best_model.zip")
     for needed in (model, run / "config.yml", run / "summary.json", run / "learning_curve.png"):
         if not needed.is_file():
@@ -39,6 +43,7 @@ def ship_run(run: Path, name: str, folder: Path = POLICY_DIR, final: bool = Fals
     meta = {
         "env_id": config["env_id"],
         "eval_env_kwargs": eval_env_kwargs,
+        "eval_params": {"deterministic": not stochastic},
         "model": "final model" if final else "best model on held-out training seeds",
         "commands": (run / "command.txt").read_text().splitlines()
         if (run / "command.txt").is_file() else [],
@@ -61,9 +66,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--name", required=True, help="name of the shipped policy")
     parser.add_argument("--final", action="store_true",
                         help="ship model.zip instead of best_model.zip")
+    parser.add_argument("--stochastic", action="store_true",
+                        help="evaluate the shipped policy with sampled actions")
     args = parser.parse_args(argv)
     try:
-        target = ship_run(args.run, args.name, final=args.final)
+        target = ship_run(args.run, args.name, final=args.final, stochastic=args.stochastic)
     except ValueError as err:
         parser.exit(2, f"ship: error: {err}\n")
     print(f"shipped {target}")

@@ -4,7 +4,8 @@
     homing-suite --episodes 200 --workers 2 --out results/full
 
 Evaluates every registered scripted controller (``baselines.available()``) and every
-shipped PPO policy (``train/shipped/*.zip`` with its ``*.yml`` evaluation settings) with the same
+shipped PPO policy (``train/shipped/*.zip`` with the evaluation settings of its ``*.yml``:
+``eval_env_kwargs``, ``eval_params``) with the same
 harness on the same seeded episodes (episode ``i`` uses seed ``seed + i``), writes one
 ``<method>.json``/``.csv`` per method into ``--out``, then runs ``homing-compare`` on them:
 ``table.md`` (printed), ``success_vs_distance.png``, ``final_distance.png`` and
@@ -15,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 import yaml
@@ -26,13 +28,24 @@ from train.evaluate import DEFAULT_ENV, evaluate, format_summary
 POLICY_DIR = Path(__file__).resolve().parent / "shipped"
 
 
-def shipped_policies(folder: Path = POLICY_DIR) -> dict[str, tuple[Path, dict]]:
-    """Shipped PPO policies: name -> (zip path, env kwargs from the ``.yml`` beside it)."""
+@dataclass(frozen=True)
+class ShippedPolicy:
+    """A shipped model and how it is evaluated (from the ``.yml`` beside it)."""
+
+    path: Path
+    env_kwargs: dict
+    params: dict    # SB3 policy parameters, e.g. {"deterministic": False}
+
+
+def shipped_policies(folder: Path = POLICY_DIR) -> dict[str, ShippedPolicy]:
+    """Shipped PPO policies by name, with the ``eval_env_kwargs`` and ``eval_params`` of
+    the ``.yml`` beside each zip."""
     found = {}
     for model in sorted(folder.glob("*.zip")):
         meta_path = model.with_suffix(".yml")
         meta = yaml.safe_load(meta_path.read_text()) if meta_path.is_file() else {}
-        found[model.stem] = (model, dict(meta.get("eval_env_kwargs") or {}))
+        found[model.stem] = ShippedPolicy(model, dict(meta.get("eval_env_kwargs") or {}),
+                                          dict(meta.get("eval_params") or {}))
     return found
 
 
@@ -48,10 +61,11 @@ def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: in
         raise ValueError(f"unknown methods {unknown}; available: {candidates}")
     paths = []
     for name in chosen:
-        policy, kwargs = (str(policies[name][0]), policies[name][1]) if name in policies \
-            else (name, {})
+        shipped = policies.get(name)
+        policy, kwargs, params = (str(shipped.path), shipped.env_kwargs, shipped.params) \
+            if shipped else (name, {}, {})
         result = evaluate(policy, env_id, episodes=episodes, seed=seed, env_kwargs=kwargs,
-                          workers=workers)
+                          workers=workers, params=params)
         print(format_summary(result))
         path = out / f"{name}.json"
         result.save(str(path))
