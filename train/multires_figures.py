@@ -1,0 +1,189 @@
+"""Figures and numbers of docs/multires.md (Shiraishi & Sawasaki multi-resolution matching).
+
+``python -m train.multires_figures localisation --out docs/multires``: self-localisation
+(§4(2-2), Fig. 10) at every point of a grid within 0.5 m of each work location of the
+``house`` and several headings, with and without daily changes; error distributions
+(``localisation.png``), summary (``localisation.json``) and localisations per second on
+one core (the ``localise`` call alone, and with rendering the panorama).
+
+``python -m train.multires_figures travel --episodes 30 --out docs/multires``: seeded
+``WorkLocations-v0`` episodes run by the ``multires`` controller; per episode the
+distance to the target when the arrival decision (Fig. 5) declares "approximately at
+the work location", the final stop distance and success (``travel.json``,
+``travel.png``). ``--daily-changes S`` runs in today's changed house.
+
+Ground truth (poses) is read here for measuring only; the controller sees observations.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+
+import baselines
+import homing_gym
+from baselines.multires import LOCALISE
+from baselines.multires_localise import localise
+from homing_gym.teaching import FeatureMap
+from train.evaluate import prepare_policy
+
+ENV_ID = "homing_gym/WorkLocations-v0"
+LOCATIONS = ("home", "kitchen", "bedroom")
+
+
+def _feature_map(obs: dict) -> FeatureMap:
+    n = int(obs["map_count"])
+    levels = int(round(math.log2(obs["panorama"].shape[1] / obs["map_panorama"].shape[1])))
+    return FeatureMap(obs["map_panorama"], obs["map_templates"][:n], obs["map_template_xy"][:n],
+                      obs["map_points"][:n], obs["map_pose"].astype(np.float64), levels)
+
+
+def grid_offsets(radius: float = 0.5, spacing: float = 0.1) -> np.ndarray:
+    """Grid points ``(N, 2)`` (m) within ``radius`` of the origin."""
+    ticks = np.arange(-radius, radius + 1e-9, spacing)
+    xy = np.array([(x, y) for x in ticks for y in ticks])
+    return xy[np.hypot(xy[:, 0], xy[:, 1]) <= radius + 1e-9]
+
+
+def localisation_experiment(daily_changes: float, spacing: float, headings: int,
+                            seed: int = 0) -> list[dict]:
+    """One row per (location, grid point, heading): errors in cm and degrees."""
+    rows = []
+    gym.register_envs(homing_gym)
+    for name in LOCATIONS:
+        env = gym.make(ENV_ID, goal_location=name, daily_changes=daily_changes)
+        obs, _ = env.reset(seed=seed)
+        fmap, u = _feature_map(obs), env.unwrapped
+        for dx, dy in grid_offsets(0.5, spacing):
+            for k in range(headings):
+                pose = np.array([fmap.pose[0] + dx, fmap.pose[1] + dy,
+                                 fmap.pose[2] + 2 * math.pi * k / headings])
+                t0 = time.process_time()
+                pano = u.render_panorama(pose)
+                t1 = time.process_time()
+                result = localise(pano, fmap)
+                t2 = time.process_time()
+                row = {"location": name, "offset": [float(dx), float(dy)],
+                       "heading": float(pose[2]), "found": result.found,
+                       "render_s": t1 - t0, "localise_s": t2 - t1, "ok": result.pose is not None}
+                if result.pose is not None:
+                    row["error_cm"] = 100 * math.dist(result.pose[:2], pose[:2])
+                    row["heading_error_deg"] = math.degrees(
+                        abs(math.remainder(result.pose[2] - pose[2], 2 * math.pi)))
+                rows.append(row)
+        env.close()
+    return rows
+
+
+def summarise_localisation(rows: list[dict]) -> dict:
+    ok = [r for r in rows if r["ok"]]
+    err = np.array([r["error_cm"] for r in ok])
+    head = np.array([r["heading_error_deg"] for r in ok])
+    loc_s = float(np.mean([r["localise_s"] for r in rows]))
+    all_s = float(np.mean([r["localise_s"] + r["render_s"] for r in rows]))
+    return {"poses": len(rows), "localised": len(ok),
+            "error_cm_median": float(np.median(err)), "error_cm_p90": float(np.percentile(err, 90)),
+            "heading_deg_median": float(np.median(head)),
+            "heading_deg_p90": float(np.percentile(head, 90)),
+            "share_within_10cm_and_2deg_of_all": float(np.sum((err < 10) & (head < 2)) / len(rows)),
+            "localisations_per_s": 1 / loc_s, "with_rendering_per_s": 1 / all_s}
+
+
+def travel_experiment(episodes: int, seed: int, daily_changes: float) -> list[dict]:
+    gym.register_envs(homing_gym)
+    env = gym.make(ENV_ID, daily_changes=daily_changes)
+    controller = baselines.make("multires")
+    prepare_policy(controller, env)
+    rows = []
+    for s in range(seed, seed + episodes):
+        obs, info = env.reset(seed=s)
+        controller.reset(s)
+        arrival, done, steps = None, False, 0
+        while not done:
+            action, _ = controller.predict(obs, episode_start=steps == 0)
+            if arrival is None and controller.phase == LOCALISE:
+                arrival = env.unwrapped.distance_to_goal
+            obs, _, terminated, truncated, info = env.step(action)
+            done, steps = terminated or truncated, steps + 1
+        rows.append({"seed": s, "path": [info["start_location"], info["goal_location"]],
+                     "arrival_cm": None if arrival is None else 100 * arrival,
+                     "final_cm": 100 * info["distance_to_goal"], "success": info["is_success"],
+                     "steps": steps, "collisions": info["collisions"]})
+        print(rows[-1], flush=True)
+    env.close()
+    return rows
+
+
+def _cdf(ax, values, label):
+    v = np.sort(np.asarray(values))
+    ax.step(v, np.arange(1, len(v) + 1) / len(v), where="post", label=label)
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("experiment", choices=("localisation", "travel"))
+    parser.add_argument("--out", default="docs/multires")
+    parser.add_argument("--spacing", type=float, default=0.1, help="grid spacing (m)")
+    parser.add_argument("--headings", type=int, default=4)
+    parser.add_argument("--episodes", type=int, default=30)
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--daily-changes", type=float, default=0.0)
+    args = parser.parse_args(argv)
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    if args.experiment == "localisation":
+        results = {}
+        fig, axes = plt.subplots(1, 2, figsize=(9, 3.5))
+        for label, changes in (("as taught", 0.0), ("daily changes 1.0", 1.0)):
+            rows = localisation_experiment(changes, args.spacing, args.headings, args.seed)
+            results[label] = {"summary": summarise_localisation(rows), "rows": rows}
+            ok = [r for r in rows if r["ok"]]
+            _cdf(axes[0], [r["error_cm"] for r in ok], label)
+            _cdf(axes[1], [r["heading_error_deg"] for r in ok], label)
+            print(label, results[label]["summary"])
+        axes[0].set_xscale("log")
+        axes[1].set_xscale("log")
+        axes[0].axvline(10, color="grey", ls=":")
+        axes[1].axvline(2, color="grey", ls=":")
+        axes[0].set_xlabel("position error (cm)")
+        axes[1].set_xlabel("heading error (deg)")
+        axes[0].set_ylabel("share of localised poses")
+        axes[0].legend()
+        fig.suptitle("Self-localisation within 0.5 m of the work locations (paper: <10 cm, <2 deg)")
+        fig.tight_layout()
+        fig.savefig(out / "localisation.png", dpi=110)
+        (out / "localisation.json").write_text(json.dumps(results, indent=1))
+    else:
+        rows = travel_experiment(args.episodes, args.seed, args.daily_changes)
+        tag = "" if args.daily_changes == 0 else f"_changes{args.daily_changes:g}"
+        summary = {"episodes": len(rows), "success_rate": float(np.mean([r["success"] for r in rows])),
+                   "final_cm_median": float(np.median([r["final_cm"] for r in rows])),
+                   "arrival_cm_median": float(np.median([r["arrival_cm"] for r in rows
+                                                         if r["arrival_cm"] is not None])),
+                   "daily_changes": args.daily_changes}
+        print(summary)
+        (out / f"travel{tag}.json").write_text(json.dumps({"summary": summary, "episodes": rows},
+                                                           indent=1))
+        fig, ax = plt.subplots(figsize=(5, 3.5))
+        _cdf(ax, [r["arrival_cm"] for r in rows if r["arrival_cm"] is not None],
+             "after the arrival decision (Fig. 5)")
+        _cdf(ax, [r["final_cm"] for r in rows], "final stop (after self-localisation)")
+        ax.axvline(10, color="grey", ls=":")
+        ax.set_xlabel("distance to the work location (cm)")
+        ax.set_ylabel("share of episodes")
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(out / f"travel{tag}.png", dpi=110)
+
+
+if __name__ == "__main__":
+    main()
