@@ -180,3 +180,43 @@ def test_stochastic_evaluation_of_a_model_is_reproducible_per_episode(tmp_path):
     with pytest.raises(ValueError, match="deterministic"):
         evaluate(str(tmp_path / "m.zip"), episodes=1, env_kwargs=kwargs,
                  params={"deterministic": "maybe"})
+
+
+def test_imitation_fits_the_policy_to_the_oracle_labels(tmp_path):
+    """DAgger's refit raises the policy's agreement with the oracle on the states it
+    collected, and a run with imitation records it and then trains PPO as usual."""
+    import gymnasium as gym
+    from stable_baselines3 import PPO
+
+    from train.extractor import policy_kwargs_for
+    from train.imitation import collect, dagger, fit
+
+    kwargs = {"panorama_shape": [16, 64], "max_episode_steps": 40, "action_type": "discrete",
+              "control_period": 0.2}
+    env = gym.make("homing_gym/LocalHoming-v0", **kwargs)
+    model = PPO("MultiInputPolicy", env, n_steps=16, batch_size=16, n_epochs=1, seed=0,
+                learning_rate=1e-3, policy_kwargs=policy_kwargs_for("panorama", features_dim=16))
+    import baselines
+    from train.evaluate import prepare_policy
+
+    oracle = baselines.make("oracle")
+    prepare_policy(oracle, env)
+    rng = np.random.default_rng(0)
+    obs, labels, before = collect(env, oracle, model, 1.0, 3, 100, rng)
+    data = {k: np.asarray(v) for k, v in obs.items()}
+    labels = np.asarray(labels)
+    first = fit(model, data, labels, 1, 32, rng)
+    last = fit(model, data, labels, 30, 32, rng)
+    assert last < first
+    mine, _ = model.predict(data, deterministic=True)
+    assert np.mean(mine == labels) > max(before, np.mean(labels == np.bincount(labels).argmax()))
+    result = dagger(model, "homing_gym/LocalHoming-v0", kwargs, 2, 1, 1, seed=7,
+                    progress=False)
+    assert result.beta == [1.0, 0.5] and result.samples[1] > result.samples[0]
+    env.close()
+
+    run = tmp_path / "run"
+    main(["--timesteps", "64", "--out", str(run), *TINY, "--hp", "imitation_iterations=1",
+          "--hp", "imitation_episodes=1", "--hp", "imitation_epochs=1"])
+    assert json.loads((run / "imitation.json").read_text())["beta"] == [1.0]
+    assert (run / "imitation_model.zip").is_file() and (run / "model.zip").is_file()

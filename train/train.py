@@ -33,11 +33,13 @@ import yaml
 
 import homing_gym
 from train.extractor import EXTRACTORS, policy_kwargs_for
+from train.imitation import dagger
 
 HYPERPARAMS = Path(str(resources.files("train") / "hyperparams" / "ppo.yml"))
 PPO_KEYS = ("n_steps", "batch_size", "n_epochs", "learning_rate", "gamma", "gae_lambda",
             "clip_range", "ent_coef", "vf_coef", "max_grad_norm")
 EVAL_SEED_OFFSET = 1_000_000
+IMITATION_SEED_OFFSET = 2_000_000
 
 
 @dataclass
@@ -57,6 +59,9 @@ class TrainConfig:
     eval_freq: int = 10_000
     eval_episodes: int = 20
     checkpoint_freq: int = 10_000
+    imitation_iterations: int = 0
+    imitation_episodes: int = 40
+    imitation_epochs: int = 4
     ppo: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -67,10 +72,13 @@ class TrainConfig:
         if self.extractor not in EXTRACTORS:
             raise ValueError(f"unknown extractor {self.extractor!r}; allowed: {EXTRACTORS}")
         for key in ("timesteps", "n_envs", "eval_freq", "eval_episodes", "checkpoint_freq",
-                    "torch_threads"):
+                    "torch_threads", "imitation_episodes", "imitation_epochs"):
             value = getattr(self, key)
             if not (isinstance(value, int) and value >= 1):
                 raise ValueError(f"{key} must be an integer >= 1, got {value!r}")
+        if not (isinstance(self.imitation_iterations, int) and self.imitation_iterations >= 0):
+            raise ValueError(f"imitation_iterations must be an integer >= 0, got "
+                             f"{self.imitation_iterations!r}")
         unknown = sorted(set(self.ppo) - set(PPO_KEYS))
         if unknown:
             raise ValueError(f"unknown PPO hyperparameters {unknown}; allowed: {list(PPO_KEYS)}")
@@ -231,6 +239,13 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
                                                            if config.extractor == "panorama"
                                                            else {})),
                         **config.ppo)
+            if config.imitation_iterations:
+                imitation = dagger(model, config.env_id, config.env_kwargs,
+                                   config.imitation_iterations, config.imitation_episodes,
+                                   config.imitation_epochs,
+                                   config.seed + IMITATION_SEED_OFFSET, progress=progress)
+                (out / "imitation.json").write_text(json.dumps(asdict(imitation), indent=2))
+                model.save(out / "imitation_model.zip")
         start_steps = model.num_timesteps
         remaining = config.timesteps - start_steps
         eval_cb = EvalCallback(eval_env, n_eval_episodes=config.eval_episodes,
