@@ -27,6 +27,14 @@ budget or stops more than ``--fail-cm`` from the goal. ``fig11`` is Fig. 11: the
 law to each marked position ``A``-``F`` from ``--runs`` seeded random starts; mean and
 standard deviation of the final error. Both write JSON and print Markdown tables beside
 the paper's numbers.
+
+    python -m train.bearing_figures pixel-reachability --out docs/bearing
+    python -m train.bearing_figures longrange --episodes 10 --out docs/bearing
+
+``pixel-reachability`` is the Fig. 4 map measured from pixels: the three laws from one
+start to a coarse grid of goals in the lab (``pixel_reachability.png`` and ``.json``).
+``longrange`` runs ``bearing-longrange`` (§3) on seeded ``LongRangeHoming-v0`` episodes
+and writes ``longrange.json``.
 """
 
 from __future__ import annotations
@@ -224,16 +232,20 @@ PAPER_FIG11 = {"A": (1.45, 1.13), "B": (4.65, 2.10), "C": (2.85, 1.41), "D": (2.
 GOAL_YAW = 0.5
 
 
-def lab_run(env, law: str, start: Sequence[float], goal: str, seed: int = 0) -> dict:
+def lab_run(env, law: str, start: Sequence[float], goal: str | Sequence[float],
+            seed: int = 0) -> dict:
     """One pixel run of ``law`` (a key of :data:`PIXEL_LAWS`) in the lab from ``start``
-    ``(x, y, yaw)`` to marked position ``goal``: final error (cm), stopped, steps."""
+    ``(x, y, yaw)`` to ``goal``, a marked position's name or a point ``(x, y)`` (m):
+    final error (cm), stopped, steps."""
     import baselines
     from train.evaluate import prepare_policy, run_episode
 
     controller = baselines.make(PIXEL_LAWS[law])
     prepare_policy(controller, env)
-    home = (*env.unwrapped.scene.metadata["marked"][goal], GOAL_YAW)
-    record = run_episode(env, controller, seed, start=start, home=home)
+    xy = env.unwrapped.scene.metadata["marked"][goal] if isinstance(goal, str) else goal
+    record = run_episode(env, controller, seed, start=start, home=(*xy, GOAL_YAW))
+    if not isinstance(goal, str):
+        goal = [round(float(v), 3) for v in goal]
     return {"law": law, "start": [round(float(v), 3) for v in start], "goal": goal,
             "error_cm": 100 * record.final_distance, "stopped": record.terminated,
             "steps": record.steps}
@@ -360,6 +372,103 @@ def fig11_table(summary: dict[str, dict[str, float]]) -> str:
     return "\n".join(lines)
 
 
+#: Start of the pixel reachability maps (m, rad): in the rest of the plane, as the 2-D
+#: maps' ``A``.
+PIXEL_START = (-2.0, 2.0, -0.8)
+
+
+def pixel_reachability(out: str, spacing: float = 1.2, max_steps: int = 600,
+                       fail_cm: float = 20.0, progress: bool = True) -> dict:
+    """Fig. 4-style maps measured in PyBullet from pixels: each law from
+    :data:`PIXEL_START` to every goal of a grid ``spacing`` m apart in the lab (goals with
+    less than 0.3 m of clearance left out); a goal is reached when the controller stops
+    within ``fail_cm``. Writes ``pixel_reachability.json`` and ``.png``; returns the
+    per-region fractions of reached goals per law."""
+    from homing_gym.scenes.base import clearance
+    from homing_gym.scenes.lab import HALF_X, HALF_Y, POSTERS
+
+    env = lab_env(max_steps)
+    scene = env.unwrapped.scene
+    triangle = np.array([pos for _, pos in POSTERS.values()])
+    xs = np.arange(-HALF_X + spacing / 2, HALF_X, spacing)
+    ys = np.arange(-HALF_Y + spacing / 2, HALF_Y, spacing)
+    goals = [(float(x), float(y)) for y in ys for x in xs if clearance(scene, (x, y)) >= 0.3]
+    runs = [lab_run(env, law, PIXEL_START, goal)
+            for law in tqdm(PIXEL_LAWS, desc="laws", disable=not progress) for goal in goals]
+    env.close()
+    for run in runs:
+        run["region"] = str(region(triangle, np.array(run["goal"])))
+        run["reached"] = bool(run["stopped"] and run["error_cm"] <= fail_cm)
+    fractions = {law: {r: float(np.mean([x["reached"] for x in runs
+                                          if x["law"] == law and x["region"] == r]))
+                       if any(x["region"] == r for x in runs) else float("nan")
+                       for r in REGIONS} for law in PIXEL_LAWS}
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
+    for ax, law in zip(axes, PIXEL_LAWS):
+        draw_regions(ax, triangle, max(HALF_X, HALF_Y))
+        for run in (x for x in runs if x["law"] == law):
+            ax.plot(*run["goal"], "o" if run["reached"] else "x", ms=9, mew=2,
+                    color="0.45" if run["reached"] else "tab:red")
+        ax.plot(*PIXEL_START[:2], "o", color="tab:orange", ms=8, mec="black")
+        ax.annotate("A", PIXEL_START[:2], textcoords="offset points", xytext=(7, -12),
+                    fontsize=10, weight="bold", color="tab:orange")
+        ax.set_xlim(-HALF_X, HALF_X)
+        ax.set_ylim(-HALF_Y, HALF_Y)
+        ax.set_aspect("equal")
+        ax.set_title(f"{TITLES[law]}: reached (gray dot) / failed (red x)", fontsize=10)
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+    fig.suptitle(f"From pixels in the lab: goals reached from A = {PIXEL_START[:2]} "
+                 f"(stop within {fail_cm:.0f} cm, {max_steps} steps)", fontsize=11)
+    fig.tight_layout()
+    os.makedirs(out, exist_ok=True)
+    fig.savefig(os.path.join(out, "pixel_reachability.png"), dpi=80)
+    plt.close(fig)
+    with open(os.path.join(out, "pixel_reachability.json"), "w") as f:
+        json.dump({"start": list(PIXEL_START), "spacing": spacing, "max_steps": max_steps,
+                   "fail_cm": fail_cm, "fractions": fractions, "runs": runs}, f, indent=1)
+    return fractions
+
+
+def longrange(out: str, episodes: int = 10, seed: int = 0, route_length: float = 8.0,
+              progress: bool = True) -> list[dict]:
+    """``bearing-longrange`` on ``LongRangeHoming-v0`` (lab, ``success_on="stop"``: a
+    success when the controller stops within 0.2 m of home) for the seeds ``seed`` ...
+    ``seed + episodes - 1``; each episode is printed and added to ``longrange.json`` as
+    it ends (``homing_from_m``: distance to home at the end of the outbound route)."""
+    import gymnasium as gym
+
+    import baselines
+    import homing_gym
+    from train.evaluate import prepare_policy, run_episode
+
+    gym.register_envs(homing_gym)
+    env = gym.make("homing_gym/LongRangeHoming-v0", route_length=route_length,
+                   success_on="stop")
+    os.makedirs(out, exist_ok=True)
+    rows: list[dict] = []
+    for s in tqdm(range(seed, seed + episodes), desc="long-range episodes",
+                  disable=not progress):
+        controller = baselines.make("bearing-longrange")
+        prepare_policy(controller, env)
+        record = run_episode(env, controller, s)
+        outbound = env.unwrapped.task.outbound_steps
+        end = np.array(record.trajectory[outbound][:2]) - record.home_pose[:2]
+        rows.append({"seed": s, "success": record.success,
+                     "final_cm": round(100 * record.final_distance, 1),
+                     "heading_error_deg": round(record.final_heading_error_deg, 1),
+                     "homing_from_m": round(float(np.hypot(*end)), 2),
+                     "steps": record.steps, "outbound_steps": outbound,
+                     "milestones": len(controller.milestones or []),
+                     "legs_done": controller.leg, "collisions": record.collisions})
+        tqdm.write(json.dumps(rows[-1]))
+        with open(os.path.join(out, "longrange.json"), "w") as f:
+            json.dump({"route_length": route_length, "params": controller.params(),
+                       "episodes": rows}, f, indent=1, default=str)
+    env.close()
+    return rows
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="bearing-figures", description=__doc__.split("\n")[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -383,8 +492,29 @@ def main(argv: list[str] | None = None) -> int:
     f11.add_argument("--runs", type=int, default=30, help="runs per marked position")
     f11.add_argument("--max-steps", type=int, default=800)
     f11.add_argument("--no-progress", action="store_true")
+    pr = sub.add_parser("pixel-reachability",
+                        help="reachability of the three laws from pixels in the lab")
+    pr.add_argument("--out", default="docs/bearing", help="output folder")
+    pr.add_argument("--spacing", type=float, default=1.2, help="goal grid spacing (m)")
+    pr.add_argument("--max-steps", type=int, default=600)
+    pr.add_argument("--fail-cm", type=float, default=20.0)
+    pr.add_argument("--no-progress", action="store_true")
+    lr = sub.add_parser("longrange", help="bearing-longrange on LongRangeHoming-v0")
+    lr.add_argument("--out", default="docs/bearing", help="output folder")
+    lr.add_argument("--episodes", type=int, default=10)
+    lr.add_argument("--seed", type=int, default=0, help="seed of the first episode")
+    lr.add_argument("--route-length", type=float, default=8.0, help="outbound route (m)")
+    lr.add_argument("--no-progress", action="store_true")
     args = parser.parse_args(argv)
-    if args.command == "fig10":
+    if args.command == "pixel-reachability":
+        fractions = pixel_reachability(args.out, args.spacing, args.max_steps, args.fail_cm,
+                                       progress=not args.no_progress)
+        print(markdown_table(fractions))
+    elif args.command == "longrange":
+        rows = longrange(args.out, args.episodes, args.seed, args.route_length,
+                         progress=not args.no_progress)
+        print(f"success {sum(r['success'] for r in rows)}/{len(rows)}")
+    elif args.command == "fig10":
         runs = fig10(args.out, args.max_steps, args.fail_cm, progress=not args.no_progress)
         print(fig10_table(runs, args.fail_cm))
     elif args.command == "fig11":
