@@ -30,6 +30,7 @@ import baselines
 import homing_gym
 from baselines.multires import LOCALISE
 from baselines.multires_localise import localise
+from homing_gym.scenes.base import clearance
 from homing_gym.teaching import FeatureMap
 from train.evaluate import prepare_policy
 
@@ -53,7 +54,8 @@ def grid_offsets(radius: float = 0.5, spacing: float = 0.1) -> np.ndarray:
 
 def localisation_experiment(daily_changes: float, spacing: float, headings: int,
                             seed: int = 0) -> list[dict]:
-    """One row per (location, grid point, heading): errors in cm and degrees."""
+    """One row per (location, grid point where the robot's body fits, heading): errors
+    in cm and degrees."""
     rows = []
     gym.register_envs(homing_gym)
     for name in LOCATIONS:
@@ -61,6 +63,9 @@ def localisation_experiment(daily_changes: float, spacing: float, headings: int,
         obs, _ = env.reset(seed=seed)
         fmap, u = _feature_map(obs), env.unwrapped
         for dx, dy in grid_offsets(0.5, spacing):
+            xy = (fmap.pose[0] + dx, fmap.pose[1] + dy)
+            if clearance(u.scene, xy) < u.robot_config.body_radius:
+                continue
             for k in range(headings):
                 pose = np.array([fmap.pose[0] + dx, fmap.pose[1] + dy,
                                  fmap.pose[2] + 2 * math.pi * k / headings])
@@ -149,7 +154,7 @@ def main(argv: list[str] | None = None) -> None:
             ok = [r for r in rows if r["ok"]]
             _cdf(axes[0], [r["error_cm"] for r in ok], label)
             _cdf(axes[1], [r["heading_error_deg"] for r in ok], label)
-            print(label, results[label]["summary"])
+            print(label, results[label]["summary"], flush=True)
         axes[0].set_xscale("log")
         axes[1].set_xscale("log")
         axes[0].axvline(10, color="grey", ls=":")
