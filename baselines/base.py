@@ -46,6 +46,17 @@ class Controller(ABC):
     #: direction is :attr:`last_home_direction`. Controllers that first probe (distance
     #: estimation takes a measuring step) set False and set the attribute themselves.
     moves_home: ClassVar[bool] = True
+    #: Env ids the method is made for; ``None``: any env with ``panorama`` and ``goal``.
+    envs: ClassVar[tuple[str, ...] | None] = None
+    #: Scenes it needs (e.g. distinctly coloured landmarks); ``None``: any scene.
+    scenes: ClassVar[tuple[str, ...] | None] = None
+
+    @classmethod
+    def made_for(cls, env_id: str, scene: str) -> bool:
+        """Whether the method applies to ``env_id`` in scene ``scene`` (what
+        ``homing-suite`` runs by default)."""
+        return ((cls.envs is None or env_id in cls.envs)
+                and (cls.scenes is None or scene in cls.scenes))
 
     def __post_init__(self) -> None:
         if self.motion not in MOTION_STYLES:

@@ -69,6 +69,10 @@ class BearingLawController(Controller):
     gain: float = 0.3
     stop_tol: float = 0.02
 
+    #: Landmarks are identified by colour: the shipped scene with three distinctly
+    #: coloured landmarks is ``lab`` (the ``arena``'s four red cylinders are one colour).
+    scenes: ClassVar[tuple[str, ...] | None] = ("lab",)
+
     def validate(self) -> None:
         if not (math.isfinite(self.min_step) and 0 < self.min_step <= self.step_length):
             raise ValueError(f"need 0 < min_step <= step_length metres, got "

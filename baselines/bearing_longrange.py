@@ -57,7 +57,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Sequence
+from typing import ClassVar, Sequence
 
 import numpy as np
 
@@ -130,6 +130,9 @@ class LongRangeBearingController(BearingLawController):
     inlier_fraction: float = 0.5
     stop_tol: float = 0.02
     klt: KLTConfig = field(default_factory=KLTConfig)
+
+    envs: ClassVar[tuple[str, ...] | None] = ("homing_gym/LongRangeHoming-v0",)
+    scenes: ClassVar[tuple[str, ...] | None] = None      # corners, not colours
 
     def validate(self) -> None:
         super().validate()

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -65,6 +65,8 @@ class MultiResController(Controller):
     max_corrections: int = 8
     camera_height: float = 0.30
     vfov_deg: float = 60.0
+
+    envs: ClassVar[tuple[str, ...] | None] = ("homing_gym/WorkLocations-v0",)
 
     def validate(self) -> None:
         if not (5 <= self.front_fov_deg <= 180):

@@ -141,6 +141,7 @@ class SelfSimilarController(Controller):
     wander_distance: float = 1.0
 
     moves_home: ClassVar[bool] = False
+    envs: ClassVar[tuple[str, ...] | None] = ("homing_gym/LandmarkNavigation-v0",)
 
     def validate(self) -> None:
         if self.planning not in PLANNING:

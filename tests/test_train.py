@@ -220,3 +220,13 @@ def test_imitation_fits_the_policy_to_the_oracle_labels(tmp_path):
           "--hp", "imitation_episodes=1", "--hp", "imitation_epochs=1"])
     assert json.loads((run / "imitation.json").read_text())["beta"] == [1.0]
     assert (run / "imitation_model.zip").is_file() and (run / "model.zip").is_file()
+
+
+def test_suite_runs_the_controllers_made_for_the_env():
+    from train.suite import suite_methods
+
+    local = suite_methods("homing_gym/LocalHoming-v0")
+    assert {"oracle", "random", "snapshot", "warping", "distance"} <= set(local)
+    assert not {"multires", "selfsimilar", "bearing", "bearing-longrange"} & set(local)
+    assert "multires" in suite_methods("homing_gym/WorkLocations-v0")
+    assert "bearing-longrange" in suite_methods("homing_gym/LongRangeHoming-v0")

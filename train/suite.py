@@ -3,10 +3,10 @@
     homing-suite                       # 20 episodes of LocalHoming-v0, seed 0, into results/
     homing-suite --episodes 200 --workers 2 --out results/full
 
-Evaluates every registered scripted controller (``baselines.available()``) and every
-shipped PPO policy (``train/shipped/*.zip`` with the evaluation settings of its ``*.yml``:
-``eval_env_kwargs``, ``eval_params``) with the same
-harness on the same seeded episodes (episode ``i`` uses seed ``seed + i``), writes one
+Evaluates every registered scripted controller made for the env (:func:`suite_methods`)
+and every shipped PPO policy trained on it (``train/shipped/*.zip`` with the evaluation
+settings of its ``*.yml``: ``eval_env_kwargs``, ``eval_params``) with the same harness
+on the same seeded episodes (episode ``i`` uses seed ``seed + i``), writes one
 ``<method>.json``/``.csv`` per method into ``--out``, then runs ``homing-compare`` on them:
 ``table.md`` (printed), ``success_vs_distance.png``, ``final_distance.png`` and
 ``trajectories.png``.
@@ -19,9 +19,11 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
+import gymnasium as gym
 import yaml
 
 import baselines
+import homing_gym  # noqa: F401  (registers the env ids)
 from train.compare import compare
 from train.evaluate import DEFAULT_ENV, evaluate, format_summary
 
@@ -35,6 +37,7 @@ class ShippedPolicy:
     path: Path
     env_kwargs: dict
     params: dict    # SB3 policy parameters, e.g. {"deterministic": False}
+    env_id: str | None = None   # the env it was trained on (None: any)
 
 
 def shipped_policies(folder: Path = POLICY_DIR) -> dict[str, ShippedPolicy]:
@@ -45,17 +48,31 @@ def shipped_policies(folder: Path = POLICY_DIR) -> dict[str, ShippedPolicy]:
         meta_path = model.with_suffix(".yml")
         meta = yaml.safe_load(meta_path.read_text()) if meta_path.is_file() else {}
         found[model.stem] = ShippedPolicy(model, dict(meta.get("eval_env_kwargs") or {}),
-                                          dict(meta.get("eval_params") or {}))
+                                          dict(meta.get("eval_params") or {}),
+                                          meta.get("env_id"))
     return found
+
+
+def suite_methods(env_id: str) -> list[str]:
+    """The registered controllers made for ``env_id`` in its default scene
+    (:meth:`baselines.Controller.made_for`): e.g. ``multires`` only on WorkLocations-v0,
+    the colour-identity bearing laws only where the default scene is ``lab``."""
+    env = gym.make(env_id)
+    scene = env.unwrapped.scene.name
+    env.close()
+    return [name for name in baselines.available()
+            if baselines.controller_class(name).made_for(env_id, scene)]
 
 
 def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: int = 0,
               workers: int = 2, methods: list[str] | None = None) -> dict[str, str]:
     """Evaluate the methods (default: all controllers and shipped policies) and compare."""
     out.mkdir(parents=True, exist_ok=True)
-    policies = shipped_policies()
+    policies = {name: p for name, p in shipped_policies().items()
+                if p.env_id in (None, env_id)}
+    made_for = suite_methods(env_id)
     candidates = baselines.available() + sorted(policies)
-    chosen = methods or candidates
+    chosen = methods or made_for + sorted(policies)
     unknown = sorted(set(chosen) - set(candidates))
     if unknown:
         raise ValueError(f"unknown methods {unknown}; available: {candidates}")
