@@ -154,8 +154,11 @@ class SB3Policy:
     worker runs it."""
 
     def __init__(self, path: str, deterministic: bool = True):
+        import torch
         from stable_baselines3 import PPO  # heavy import: only when a model is evaluated
 
+        # one observation at a time: a thread pool only spins against the other workers
+        torch.set_num_threads(1)
         self.path = path
         self.deterministic = bool(deterministic)
         self.model = PPO.load(path, device="cpu")

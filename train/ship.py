@@ -25,6 +25,13 @@ from train.suite import POLICY_DIR
 MAX_BYTES = 10 * 2**20
 
 
+class _PlainDumper(yaml.SafeDumper):
+    """Writes repeated values in full instead of as YAML anchors and aliases."""
+
+    def ignore_aliases(self, data) -> bool:
+        return True
+
+
 def ship_run(run: Path, name: str, folder: Path = POLICY_DIR, final: bool = False,
              stochastic: bool = False) -> Path:
     """Copy run ``run`` into ``folder`` as ``name``; returns the shipped zip's path.
@@ -52,10 +59,12 @@ def ship_run(run: Path, name: str, folder: Path = POLICY_DIR, final: bool = Fals
         "env_steps_per_s": summary["env_steps_per_s"],
         "config": config,
     }
+    if (run / "imitation.json").is_file():
+        meta["imitation"] = json.loads((run / "imitation.json").read_text())
     folder.mkdir(parents=True, exist_ok=True)
     target = folder / f"{name}.zip"
     shutil.copyfile(model, target)
-    (folder / f"{name}.yml").write_text(yaml.safe_dump(meta, sort_keys=False))
+    (folder / f"{name}.yml").write_text(yaml.dump(meta, Dumper=_PlainDumper, sort_keys=False))
     shutil.copyfile(run / "learning_curve.png", folder / f"{name}_curve.png")
     return target
 
