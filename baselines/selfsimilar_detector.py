@@ -60,9 +60,15 @@ class DetectorConfig:
 
     ``window`` w and ``row_step`` k: the paper's typical values for 640 x 480 are 45 and 6
     (§3); both depend only on the smallest expected landmark (its pattern must be at least
-    about ``w`` pixels wide and ``3k`` rows tall). ``min_peak`` c_min: the paper gives no
-    number; its full-contrast peaks measure 0.66 (§3.1), ours 0.6 on synthetic scanlines,
-    so 0.2 accepts patterns down to about a third of full contrast. ``sharpness`` gives
+    about ``w`` pixels wide and ``3k`` rows tall). ``min_peak`` c_min: a fixed threshold
+    "corresponding to a minimum contrast" (§3.1), the paper gives no number. A pattern of
+    image contrast c answers ``m = c`` at best (§3, Eq. 7), less once sampled: ours
+    measure 0.6 c on synthetic scanlines (the paper's 0.66, §3.1) and about 0.42 c in
+    rendered 320 x 240 views with w = 22, where a white panel under the scene's light
+    renders at 0.6, so full contrast gives peaks of 0.25 and contrast 0.25 peaks of
+    0.065. Hence 0.04: patterns down to about 0.1 of image contrast; the sharpness
+    test and the chains of §3.2 keep the false positives down (an earlier 0.2 rejected
+    every panel below half contrast, in the match, not in the barcode). ``sharpness`` gives
     ``delta = max(1, round(sharpness * w))``: the paper says about w/10, but with the
     origin between pixels our 2/3-similar peaks are still at 0.55-0.7 of their height
     at +-w/10 and fall below half only at +-w/7.5 (6 pixels for w = 45), while a
@@ -75,7 +81,7 @@ class DetectorConfig:
     p: float = DEFAULT_P
     window: int = 45
     row_step: int = 6
-    min_peak: float = 0.2
+    min_peak: float = 0.04
     sharpness: float = 0.13
     coarse_rows: bool = False
     peak_step: int = 1
