@@ -50,6 +50,11 @@ class Controller(ABC):
     envs: ClassVar[tuple[str, ...] | None] = None
     #: Scenes it needs (e.g. distinctly coloured landmarks); ``None``: any scene.
     scenes: ClassVar[tuple[str, ...] | None] = None
+    #: True when the controller reads the observation only when it decides, never while
+    #: :meth:`predict` plays a queued move: the harness may then let the env skip the
+    #: images in between (:meth:`needs_next_observation`). Controllers that watch every
+    #: step or override :meth:`predict` keep False.
+    reads_at_decisions_only: ClassVar[bool] = False
 
     @classmethod
     def made_for(cls, env_id: str, scene: str) -> bool:
@@ -128,6 +133,11 @@ class Controller(ABC):
             if not self._queue:  # a move below the command resolution: stop this step
                 return self._helper.stop_action(), state
         return self._queue.pop(0), state
+
+    def needs_next_observation(self) -> bool:
+        """Whether the next :meth:`predict` reads its observation: always, unless
+        :attr:`reads_at_decisions_only` and a move is still queued."""
+        return not (self.reads_at_decisions_only and self._queue)
 
     def params(self) -> dict[str, Any]:
         """The parameter values (dataclass fields) as a plain dict."""

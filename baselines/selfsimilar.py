@@ -141,6 +141,7 @@ class SelfSimilarController(Controller):
     wander_distance: float = 1.0
 
     moves_home: ClassVar[bool] = False
+    reads_at_decisions_only: ClassVar[bool] = True
     envs: ClassVar[tuple[str, ...] | None] = ("homing_gym/LandmarkNavigation-v0",)
 
     def validate(self) -> None:

@@ -125,12 +125,31 @@ class HomingEnv(gym.Env):
         self.pose = np.zeros(3)
         self.trajectory: list[tuple[float, float]] = []
         self.collisions = 0
-        self._panorama = np.zeros((H, W, 3), np.uint8)
+        self._panorama: np.ndarray | None = None   # rendered on first use after a move
+        self._last_obs: dict[str, np.ndarray] = {}
+        self._skip_images = False
         self.goal_index = 0
         self._goal_views: list[dict[str, np.ndarray]] = []
         self._goal_obs: dict[str, np.ndarray] = {}
 
     # -- helpers --------------------------------------------------------------------------
+    @property
+    def panorama(self) -> np.ndarray:
+        """The panorama at the robot's current pose, rendered when first read after a
+        move (observation keys ``panorama``, ``omni``, ``signature`` and the ``rgb_array``
+        picture read it; an agent that observes only other keys costs no panorama)."""
+        if self._panorama is None:
+            self._panorama = self.render_panorama(self.pose)
+        return self._panorama
+
+    def skip_next_images(self) -> None:
+        """Harness hint for one step: the agent will not read the next observation (a
+        scripted controller in the middle of a move, see
+        :meth:`baselines.base.Controller.needs_next_observation`), so the next
+        :meth:`step` renders no camera image and returns the previous observation with
+        fresh ``odometry``. Episodes, rewards and info are unchanged."""
+        self._skip_images = True
+
     def render_panorama(self, pose) -> np.ndarray:
         """Panorama (uint8 HWC) the robot's camera would see at ``pose`` in the current
         world and the episode's lighting, rendered as is (the robot body stays where it is)."""
@@ -204,21 +223,27 @@ class HomingEnv(gym.Env):
         stop = abs(v) < self.stop_threshold and abs(w) < self.stop_threshold
         return float(v), float(w), bool(stop)
 
-    def _observation(self) -> dict[str, np.ndarray]:
+    def _observation(self, skip_images: bool = False) -> dict[str, np.ndarray]:
+        if skip_images and self._last_obs:
+            obs = {k: v.copy() for k, v in self._last_obs.items()}
+            if "odometry" in self.obs_keys:
+                obs["odometry"] = self.odometry.estimate.astype(np.float32)
+            return obs
         obs: dict[str, np.ndarray] = {}
         for key in self.obs_keys:
             if key == "panorama":
-                obs[key] = self._panorama.copy()
+                obs[key] = self.panorama.copy()
             elif key == "omni":
-                obs[key] = self.camera.omni(self._panorama)
+                obs[key] = self.camera.omni(self.panorama)
             elif key == "signature":
-                obs[key] = self.camera.signature(self._panorama)
+                obs[key] = self.camera.signature(self.panorama)
             elif key == "odometry":
                 obs[key] = self.odometry.estimate.astype(np.float32)
             elif key in self._goal_obs:
                 obs[key] = self._goal_obs[key].copy()
         obs.update({k: v for k, v in self.task.extra_observation(self).items()
                     if k in self.obs_keys})
+        self._last_obs = obs
         return obs
 
     def _episode_with_options(self, episode: Episode, options: dict) -> Episode:
@@ -268,7 +293,9 @@ class HomingEnv(gym.Env):
         robot.set_pose(*self.episode.start)
         self.pose = robot.pose()
         self.odometry.reset(to_frame(self.episode.home, self.pose), robot.wheel_angles())
-        self._panorama = self.render_panorama(self.pose)
+        self._panorama = None
+        self._skip_images = False
+        self._last_obs = {}
         self.trajectory = [(float(self.pose[0]), float(self.pose[1]))]
         self.collisions = 0
         self.task.on_reset(self)
@@ -284,14 +311,15 @@ class HomingEnv(gym.Env):
         self.pose = robot.pose()
         if "odometry" in self.obs_keys:
             self.odometry.update(robot.wheel_angles(), self.np_random)
-        self._panorama = self.render_panorama(self.pose)
+        self._panorama = None
+        skip_images, self._skip_images = self._skip_images, False
         self.trajectory.append((float(self.pose[0]), float(self.pose[1])))
         self.collisions += int(collision)
         rewards, terminated, success = self.task.step_outcome(self, collision, stopped)
         reward = float(sum(rewards.values()))
         if self.render_mode == "human":
             self.render()
-        return (self._observation(), reward, bool(terminated), False,
+        return (self._observation(skip_images), reward, bool(terminated), False,
                 self._info(collision, success, rewards))
 
     def render(self):
@@ -312,7 +340,7 @@ class HomingEnv(gym.Env):
                            success_radius=getattr(self.task, "success_radius", None),
                            waypoints=self.episode.goals)
         caption = f"(d = {self.distance_to_goal:.2f} m)"
-        return compose_frame(top, self._panorama, self._goal_obs["goal"], caption)
+        return compose_frame(top, self.panorama, self._goal_obs["goal"], caption)
 
     def close(self):
         if hasattr(self, "sim"):

@@ -16,7 +16,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from homing_gym.scenes.base import Scene, clearance
+from homing_gym.scenes.base import Scene, clearances
 
 SQRT2 = math.sqrt(2.0)
 
@@ -32,11 +32,10 @@ def occupancy(scene: Scene, radius: float, resolution: float) -> tuple[np.ndarra
     (xmin, ymin), (xmax, ymax) = scene.bounds
     nx = int(math.floor((xmax - xmin) / resolution)) + 1
     ny = int(math.floor((ymax - ymin) / resolution)) + 1
-    free = np.zeros((nx, ny), bool)
-    for i in range(nx):
-        for j in range(ny):
-            free[i, j] = clearance(scene, (xmin + i * resolution, ymin + j * resolution)) >= radius
-    return free, (xmin, ymin)
+    gx, gy = np.meshgrid(xmin + np.arange(nx) * resolution, ymin + np.arange(ny) * resolution,
+                         indexing="ij")
+    free = clearances(scene, np.stack([gx.ravel(), gy.ravel()], axis=1)) >= radius
+    return free.reshape(nx, ny), (xmin, ymin)
 
 
 def segment_free(scene: Scene, a, b, radius: float, step: float = 0.01) -> bool:
@@ -44,8 +43,9 @@ def segment_free(scene: Scene, a, b, radius: float, step: float = 0.01) -> bool:
     extra coordinates such as a yaw are ignored)."""
     a, b = (float(a[0]), float(a[1])), (float(b[0]), float(b[1]))
     n = max(1, int(math.ceil(math.dist(a, b) / step)))
-    return all(clearance(scene, (a[0] + (b[0] - a[0]) * k / n, a[1] + (b[1] - a[1]) * k / n))
-               >= radius for k in range(n + 1))
+    t = np.arange(n + 1)[:, None] / n
+    points = np.asarray(a) + t * (np.asarray(b) - np.asarray(a))
+    return bool(np.all(clearances(scene, points) >= radius))
 
 
 def path_length(points) -> float:

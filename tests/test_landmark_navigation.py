@@ -74,3 +74,18 @@ def test_landmarks_are_removed_and_occluded_at_random(make_env):
 def test_bad_arguments_raise(make_env, kwargs, message):
     with pytest.raises(ValueError, match=message):
         make_env(ENV_ID, **kwargs)
+
+
+def test_skip_next_images_reuses_the_view_for_one_step_and_keeps_odometry_fresh(make_env):
+    """The harness hint for controllers mid-move: one step without rendering returns the
+    previous images with fresh odometry; the step after renders again."""
+    env = make_env(ENV_ID, obs_keys=("view", "goal_id", "odometry"))
+    obs, _ = env.reset(seed=1)
+    turn = np.array([0.0, 1.0], np.float32)
+    obs1, *_ = env.step(turn)
+    env.unwrapped.skip_next_images()
+    obs2, *_ = env.step(turn)
+    assert np.array_equal(obs2["view"], obs1["view"])
+    assert not np.allclose(obs2["odometry"], obs1["odometry"])
+    obs3, *_ = env.step(turn)
+    assert not np.array_equal(obs3["view"], obs2["view"])

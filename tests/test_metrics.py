@@ -95,3 +95,17 @@ def test_shortest_path_is_straight_when_free_and_bends_around_a_cylinder():
     path = shortest_path(scene, (0.9, 0.35), (0.0, 0.35), radius=0.16)
     assert path_length(path) == pytest.approx(2 * tangent + arc, rel=0.01)
     assert all(segment_free(scene, a, b, 0.16 - 1e-6) for a, b in zip(path[:-1], path[1:]))
+
+
+def test_clearances_hand_computed_for_a_wall_a_box_and_a_cylinder():
+    from homing_gym.scenes.base import Landmark, Scene, Wall, clearance, clearances
+
+    scene = Scene("probe", ((-5, -5), (5, 5)), walls=(Wall((0, -1), (0, 1), thickness=0.1),),
+                  landmarks=(Landmark((3, 0), shape="box", extent=(1.0, 0.4), yaw=math.pi / 2),
+                             Landmark((-3, 3), radius=0.5)))
+    points = [(0.55, 0), (0, 1.3), (3.0, -1.0), (3.3, 0), (-3, 4), (4.9, 4.9), (3, 0.2)]
+    # wall face 0.5 / 0.3 past its end less half its thickness; the box (0.4 x 1.0 once turned) 0.5 below / 0.1
+    # beside; the cylinder 0.5; the bounds 0.1; inside the box 0
+    expected = [0.5, 0.25, 0.5, 0.1, 0.5, 0.1, 0.0]
+    assert np.allclose(clearances(scene, points), expected)
+    assert [clearance(scene, p) for p in points] == pytest.approx(expected)

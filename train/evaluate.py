@@ -208,6 +208,8 @@ def run_episode(env: gym.Env, policy, seed: int, start: Sequence[float] | None =
     while not done:
         action, state = policy.predict(obs, state=state, episode_start=episode_start)
         episode_start = False
+        if not getattr(policy, "needs_next_observation", lambda: True)():
+            u.skip_next_images()        # mid-move: the images would go unread
         obs, _, terminated, truncated, info = env.step(action)
         steps += 1
         done = terminated or truncated

@@ -10,6 +10,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import lru_cache
+
+import numpy as np
 
 from homing_gym.textures import check_texture
 
@@ -155,33 +158,62 @@ def square_walls(side: float, **wall_kwargs) -> tuple[Wall, ...]:
     return tuple(Wall(corners[i], corners[(i + 1) % 4], **wall_kwargs) for i in range(4))
 
 
-def _segment_distance(point: tuple[float, float], a, b) -> float:
-    ax, ay = a
-    bx, by = b
-    px, py = point
-    dx, dy = bx - ax, by - ay
-    t = max(0.0, min(1.0, ((px - ax) * dx + (py - ay) * dy) / (dx * dx + dy * dy)))
-    return math.hypot(px - ax - t * dx, py - ay - t * dy)
+@dataclass(frozen=True)
+class _Obstacles:
+    """A scene's walls and landmark footprints as arrays, for :func:`clearances`."""
+
+    starts: np.ndarray      # (W, 2) wall centre-line ends (m)
+    dirs: np.ndarray        # (W, 2) end - start
+    half_thickness: np.ndarray
+    centres: np.ndarray     # (L, 2) landmark positions
+    cos_sin: np.ndarray     # (L, 2) of the yaw
+    half_extent: np.ndarray  # (L, 2) box half sizes (0 for cylinders)
+    radius: np.ndarray      # (L,) cylinder radii (0 for boxes)
 
 
-def landmark_distance(lm: Landmark, point: tuple[float, float]) -> float:
-    """Distance (metres) from a floor point to the landmark's footprint (0 inside)."""
-    dx, dy = point[0] - lm.position[0], point[1] - lm.position[1]
-    if lm.shape == "cylinder":
-        return max(0.0, math.hypot(dx, dy) - lm.radius)
-    c, s = math.cos(lm.yaw), math.sin(lm.yaw)
-    lx, ly = abs(c * dx + s * dy) - lm.extent[0] / 2, abs(-s * dx + c * dy) - lm.extent[1] / 2
-    return math.hypot(max(lx, 0.0), max(ly, 0.0))
+@lru_cache(maxsize=32)
+def _obstacles(scene: Scene) -> _Obstacles:
+    walls, lms = scene.walls, scene.landmarks
+    starts = np.array([w.start for w in walls], np.float64).reshape(-1, 2)
+    ends = np.array([w.end for w in walls], np.float64).reshape(-1, 2)
+    box = [lm.shape != "cylinder" for lm in lms]
+    return _Obstacles(
+        starts=starts, dirs=ends - starts,
+        half_thickness=np.array([w.thickness / 2 for w in walls], np.float64),
+        centres=np.array([lm.position for lm in lms], np.float64).reshape(-1, 2),
+        cos_sin=np.array([(math.cos(lm.yaw), math.sin(lm.yaw)) for lm in lms],
+                         np.float64).reshape(-1, 2),
+        half_extent=np.array([(lm.extent[0] / 2, lm.extent[1] / 2) if b else (0.0, 0.0)
+                              for lm, b in zip(lms, box)], np.float64).reshape(-1, 2),
+        radius=np.array([0.0 if b else lm.radius for lm, b in zip(lms, box)], np.float64))
+
+
+def clearances(scene: Scene, points) -> np.ndarray:
+    """:func:`clearance` of many floor points ``(N, 2)`` (metres) at once: the distance
+    to each wall's centre line less half its thickness, to each landmark's footprint
+    (a cylinder's disc, a box's rotated rectangle; 0 inside) and to the bounds."""
+    pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    (xmin, ymin), (xmax, ymax) = scene.bounds
+    free = np.minimum(np.minimum(pts[:, 0] - xmin, xmax - pts[:, 0]),
+                      np.minimum(pts[:, 1] - ymin, ymax - pts[:, 1]))
+    ob = _obstacles(scene)
+    if len(ob.starts):
+        rel = pts[:, None, :] - ob.starts[None]                       # (N, W, 2)
+        t = np.clip(np.einsum("nwk,wk->nw", rel, ob.dirs)
+                    / np.einsum("wk,wk->w", ob.dirs, ob.dirs), 0.0, 1.0)
+        gap = rel - t[..., None] * ob.dirs[None]
+        free = np.minimum(free, np.min(np.hypot(gap[..., 0], gap[..., 1])
+                                       - ob.half_thickness, axis=1))
+    if len(ob.centres):
+        d = pts[:, None, :] - ob.centres[None]                        # (N, L, 2)
+        c, s = ob.cos_sin[:, 0], ob.cos_sin[:, 1]
+        lx = np.maximum(np.abs(c * d[..., 0] + s * d[..., 1]) - ob.half_extent[:, 0], 0.0)
+        ly = np.maximum(np.abs(-s * d[..., 0] + c * d[..., 1]) - ob.half_extent[:, 1], 0.0)
+        free = np.minimum(free, np.min(np.maximum(np.hypot(lx, ly) - ob.radius, 0.0), axis=1))
+    return free
 
 
 def clearance(scene: Scene, point: tuple[float, float]) -> float:
     """Free distance (metres) from a floor point to the nearest wall, landmark or scene
     boundary; 0 or less means the point is blocked or outside ``scene.bounds``."""
-    (xmin, ymin), (xmax, ymax) = scene.bounds
-    x, y = point
-    free = min(x - xmin, xmax - x, y - ymin, ymax - y)
-    for wall in scene.walls:
-        free = min(free, _segment_distance(point, wall.start, wall.end) - wall.thickness / 2)
-    for lm in scene.landmarks:
-        free = min(free, landmark_distance(lm, point))
-    return free
+    return float(clearances(scene, (point,))[0])
