@@ -61,12 +61,17 @@ class OracleController(Controller):
             if self.align_heading and abs(turn) > self.heading_tolerance:
                 return Move(turn, 0.0)
             return None
-        target = self._waypoint(scene, pose, home)
+        return self.move_to(pose, self.waypoint(scene, pose, home))
+
+    def move_to(self, pose, target) -> Move:
+        """The move from ``pose`` towards the floor point ``target``: turn to it, drive at
+        most ``step_length`` metres."""
         return Move(bearing_to(pose, target),
                     min(self.step_length, math.hypot(target[0] - pose[0], target[1] - pose[1])))
 
-    def _waypoint(self, scene, pose, home) -> tuple[float, float]:
-        """Home if the straight way is free, else the farthest visible path waypoint."""
+    def waypoint(self, scene, pose, home) -> tuple[float, float]:
+        """Home if the straight way from ``pose`` is free, else the farthest visible
+        waypoint of the shortest path (planned once per episode, replanned when lost)."""
         xy = (float(pose[0]), float(pose[1]))
         # slack for drift off the planned path, and for a robot already pushed close to
         # an obstacle (never below the body radius plus a contact margin)

@@ -34,12 +34,14 @@ import yaml
 import homing_gym
 from train.extractor import EXTRACTORS, policy_kwargs_for
 from train.imitation import dagger
+from train.pretrain import pretrain
 
 HYPERPARAMS = Path(str(resources.files("train") / "hyperparams" / "ppo.yml"))
 PPO_KEYS = ("n_steps", "batch_size", "n_epochs", "learning_rate", "gamma", "gae_lambda",
             "clip_range", "ent_coef", "vf_coef", "max_grad_norm")
 EVAL_SEED_OFFSET = 1_000_000
 IMITATION_SEED_OFFSET = 2_000_000
+PRETRAIN_SEED_OFFSET = 3_000_000
 
 
 @dataclass
@@ -62,6 +64,9 @@ class TrainConfig:
     imitation_iterations: int = 0
     imitation_episodes: int = 40
     imitation_epochs: int = 4
+    pretrain_samples: int = 0
+    pretrain_positions: int = 4000
+    pretrain_scenes: int = 1
     ppo: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -72,13 +77,15 @@ class TrainConfig:
         if self.extractor not in EXTRACTORS:
             raise ValueError(f"unknown extractor {self.extractor!r}; allowed: {EXTRACTORS}")
         for key in ("timesteps", "n_envs", "eval_freq", "eval_episodes", "checkpoint_freq",
-                    "torch_threads", "imitation_episodes", "imitation_epochs"):
+                    "torch_threads", "imitation_episodes", "imitation_epochs",
+                    "pretrain_positions", "pretrain_scenes"):
             value = getattr(self, key)
             if not (isinstance(value, int) and value >= 1):
                 raise ValueError(f"{key} must be an integer >= 1, got {value!r}")
-        if not (isinstance(self.imitation_iterations, int) and self.imitation_iterations >= 0):
-            raise ValueError(f"imitation_iterations must be an integer >= 0, got "
-                             f"{self.imitation_iterations!r}")
+        for key in ("imitation_iterations", "pretrain_samples"):
+            value = getattr(self, key)
+            if not (isinstance(value, int) and value >= 0):
+                raise ValueError(f"{key} must be an integer >= 0, got {value!r}")
         unknown = sorted(set(self.ppo) - set(PPO_KEYS))
         if unknown:
             raise ValueError(f"unknown PPO hyperparameters {unknown}; allowed: {list(PPO_KEYS)}")
@@ -239,6 +246,13 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
                                                            if config.extractor == "panorama"
                                                            else {})),
                         **config.ppo)
+            if config.pretrain_samples:
+                pretrained = pretrain(model, config.env_id, config.env_kwargs,
+                                      config.pretrain_positions, config.pretrain_scenes,
+                                      config.pretrain_samples,
+                                      config.seed + PRETRAIN_SEED_OFFSET, progress=progress)
+                (out / "pretrain.json").write_text(json.dumps(asdict(pretrained), indent=2))
+                model.save(out / "pretrain_model.zip")
             if config.imitation_iterations:
                 imitation = dagger(model, config.env_id, config.env_kwargs,
                                    config.imitation_iterations, config.imitation_episodes,

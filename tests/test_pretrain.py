@@ -1,0 +1,102 @@
+"""Behaviour cloning on rendered pose pairs (train/pretrain.py)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import baselines
+from baselines.motion import FORWARD, LEFT, RIGHT, MotionHelper
+from homing_gym.geometry import wrap_angle
+from train.evaluate import prepare_policy
+from train.pretrain import pair_labels, pair_samples, pair_set, render_bank, rolled
+from train.train import main
+
+KWARGS = {"scene": "arena", "panorama_shape": [16, 64], "action_type": "discrete",
+          "control_period": 0.2}
+
+
+@pytest.fixture(scope="module")
+def env():
+    env = gym.make("homing_gym/LocalHoming-v0", **KWARGS)
+    yield env
+    env.close()
+
+
+def test_turning_rolls_the_panorama_towards_higher_columns(env):
+    """The bank's premise: the panorama at heading k columns is the heading-0 panorama
+    rolled by +k columns, up to resampling; rolling the other way is far off."""
+    u = env.unwrapped
+    env.reset(seed=0)
+    width = KWARGS["panorama_shape"][1]
+    pose = np.array([0.0, 0.9, 0.0])
+    u.sim.robot.set_pose(*pose)
+    base = u.render_panorama(pose)
+    for k in (5, -9, 20):
+        turned = pose + [0.0, 0.0, k * 2 * math.pi / width]
+        u.sim.robot.set_pose(*turned)
+        view = u.render_panorama(turned).astype(float)
+        good = np.abs(rolled(base[None], np.array([k]))[0] - view).mean()
+        bad = np.abs(rolled(base[None], np.array([-k]))[0] - view).mean()
+        assert good < 4.0 and bad > 4 * good, (k, good, bad)
+
+
+def test_pair_labels_turn_towards_the_oracle_waypoint(env):
+    """A label is the oracle's first action: forward when its waypoint lies within half a
+    turn step of the heading, else a turn towards it (counter-clockwise: left)."""
+    oracle = baselines.make("oracle")
+    prepare_policy(oracle, env)
+    helper = MotionHelper(oracle.motion_spec, oracle.motion)
+    bank = render_bank(env, 12, 1, seed=3, progress=False)
+    rng = np.random.default_rng(0)
+    pairs = pair_set(bank, 30, (0.15, 1.5), oracle, rng, progress=False)
+    d = np.linalg.norm(bank.positions[pairs.current] - bank.positions[pairs.home], axis=1)
+    assert np.all((d >= 0.15) & (d <= 1.5))
+    width = KWARGS["panorama_shape"][1]
+    p = np.repeat(np.arange(30), width)
+    k = np.tile(np.arange(width), 30)
+    labels = pair_labels(bank, pairs, p, k, oracle, helper)
+    half_step = oracle.motion_spec.step_turn / 2
+    for pair, column, label in zip(p, k, labels):
+        x, y = bank.positions[pairs.current[pair]]
+        tx, ty = pairs.target[pair]
+        bearing = wrap_angle(math.atan2(ty - y, tx - x) - column * 2 * math.pi / width)
+        if abs(abs(bearing) - half_step) > 1e-6:
+            expected = FORWARD if abs(bearing) < half_step else (LEFT if bearing > 0 else RIGHT)
+            assert label == expected, (pair, column, bearing)
+    obs, labels = pair_samples(bank, pairs, 50, oracle, helper, rng)
+    assert obs["panorama"].shape == obs["goal"].shape == (50, 16, 64, 3)
+    assert set(labels.tolist()) <= {FORWARD, LEFT, RIGHT}
+
+
+def test_pretraining_runs_from_homing_train_and_records_its_fit(tmp_path):
+    run = tmp_path / "run"
+    main(["--timesteps", "64", "--out", str(run), "--n-envs", "1", "--vec", "dummy",
+          "--no-progress", "--env-kwargs", json.dumps({**KWARGS, "max_episode_steps": 16}),
+          "--hp", "n_steps=64", "--hp", "batch_size=32", "--hp", "n_epochs=1",
+          "--hp", "eval_freq=128", "--hp", "eval_episodes=1", "--hp", "checkpoint_freq=128",
+          "--hp", "features_dim=32", "--hp", "pretrain_samples=2048",
+          "--hp", "pretrain_positions=40"])
+    record = json.loads((run / "pretrain.json").read_text())
+    assert record["positions"] == 40 and record["samples"][-1] == 2048
+    assert (run / "pretrain_model.zip").is_file() and (run / "model.zip").is_file()
+
+
+def test_pretraining_refuses_other_observation_keys():
+    from stable_baselines3 import PPO
+
+    from train.extractor import policy_kwargs_for
+    from train.pretrain import pretrain
+
+    env = gym.make("homing_gym/LocalHoming-v0", obs_keys=("panorama", "goal", "odometry"),
+                   **KWARGS)
+    model = PPO("MultiInputPolicy", env, n_steps=16, batch_size=16,
+                policy_kwargs=policy_kwargs_for("panorama", features_dim=16))
+    with pytest.raises(ValueError, match="obs_keys"):
+        pretrain(model, "homing_gym/LocalHoming-v0",
+                 {**KWARGS, "obs_keys": ("panorama", "goal", "odometry")}, 8, 1, 16, 0)
+    env.close()

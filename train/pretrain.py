@@ -1,0 +1,222 @@
+"""Behaviour cloning of the ``oracle`` on rendered pose pairs: a warm start for policies
+that home from a panorama and a goal panorama.
+
+Rolling out episodes to collect imitation data costs a physics step and a render per
+sample and gives strongly correlated samples (about 100 per second here). This module gets
+them from a *bank* of panoramas instead. A cylindrical panorama taken at heading ``theta``
+is the panorama taken at heading 0 at the same place, rolled by ``theta * W / (2 pi)``
+columns towards higher column indices (``tests/test_pretrain.py`` checks this on rendered
+panoramas). So ``N`` panoramas rendered at heading 0 at free floor positions give
+``N^2 W^2`` pairs (current view at position ``i`` and heading ``k``, goal view at position
+``j`` and heading ``m``). Each pair is labelled with the oracle's action from pose
+``(x_i, y_i, k)`` towards home ``j``: its waypoint on the true shortest path (a function
+of the two positions, computed once per pair) turned into the env's first discrete or
+continuous command (:class:`baselines.motion.MotionHelper`). The home heading never
+changes the label, and the current heading only rotates the bearing, so the headings are
+drawn afresh for every sample: every pass sees new images.
+
+The policy network is fitted by maximum likelihood of the labels
+(:func:`train.imitation.fit`), on fresh samples each chunk; its agreement with the oracle
+is measured on pairs from a separate bank of positions. The oracle's ground truth labels
+training data only; the policy acts from the two images.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import gymnasium as gym
+import numpy as np
+from tqdm.auto import tqdm
+
+import baselines
+from baselines.motion import MotionHelper
+from homing_gym.scenes.base import Scene
+from homing_gym.tasks.base import sample_free_pose
+from train.evaluate import prepare_policy
+from train.imitation import fit
+
+#: Observation keys a bank can produce.
+BANK_KEYS = ("panorama", "goal")
+
+
+@dataclass
+class PoseBank:
+    """Panoramas (uint8 ``(N, H, W, 3)``) rendered at heading 0 at free floor positions
+    (``(N, 2)`` metres) of one or more scene instances (``scene_index`` into ``scenes``)."""
+
+    positions: np.ndarray
+    panoramas: np.ndarray
+    scene_index: np.ndarray
+    scenes: list[Scene]
+
+
+@dataclass
+class PairSet:
+    """Pairs of bank entries: the robot's position ``current``, the home ``home`` and the
+    oracle's waypoint ``target`` (``(P, 2)`` metres, world frame) from one to the other."""
+
+    current: np.ndarray
+    home: np.ndarray
+    target: np.ndarray
+
+
+@dataclass
+class PretrainResult:
+    """Per chunk: samples fitted so far, mean fit loss, agreement with the oracle on the
+    validation pairs (share of samples whose most likely action is the oracle's)."""
+
+    positions: int = 0
+    pairs: int = 0
+    samples: list[int] = field(default_factory=list)
+    loss: list[float] = field(default_factory=list)
+    agreement: list[float] = field(default_factory=list)
+
+
+def render_bank(env: gym.Env, positions_per_scene: int, scenes: int, seed: int,
+                progress: bool = True) -> PoseBank:
+    """Render ``positions_per_scene`` heading-0 panoramas in each of ``scenes`` scene
+    instances (``env.reset(seed=seed + s)``: new worlds for randomised scenes); positions
+    keep the task's clearance from obstacles."""
+    unwrapped = env.unwrapped
+    margin = float(getattr(unwrapped.task, "clearance_margin", 0.22))
+    rng = np.random.default_rng(seed)
+    positions, panoramas, index, worlds = [], [], [], []
+    bar = tqdm(total=scenes * positions_per_scene, desc="rendering pose bank",
+               disable=not progress)
+    for s in range(scenes):
+        env.reset(seed=seed + s)
+        worlds.append(unwrapped.scene)
+        for _ in range(positions_per_scene):
+            pose = sample_free_pose(unwrapped.scene, rng, margin)
+            pose[2] = 0.0
+            unwrapped.sim.robot.set_pose(*pose)
+            panoramas.append(unwrapped.render_panorama(pose))
+            positions.append(pose[:2])
+            index.append(s)
+            bar.update()
+    bar.close()
+    return PoseBank(np.asarray(positions), np.asarray(panoramas), np.asarray(index), worlds)
+
+
+def pair_set(bank: PoseBank, n_pairs: int, distance: tuple[float, float], oracle,
+             rng: np.random.Generator, progress: bool = True) -> PairSet:
+    """``n_pairs`` (current, home) pairs from the same scene instance, ``distance`` =
+    (min, max) metres apart, with the oracle's waypoint for each."""
+    lo, hi = distance
+    current, home, target = [], [], []
+    bar = tqdm(total=n_pairs, desc="labelling pose pairs", disable=not progress)
+    while len(current) < n_pairs:
+        j = int(rng.integers(len(bank.positions)))
+        d = np.linalg.norm(bank.positions - bank.positions[j], axis=1)
+        candidates = np.flatnonzero((d >= lo) & (d <= hi)
+                                    & (bank.scene_index == bank.scene_index[j]))
+        if len(candidates) == 0:
+            continue
+        i = int(rng.choice(candidates))
+        oracle.reset()
+        pose = (*bank.positions[i], 0.0)
+        home_pose = (*bank.positions[j], 0.0)
+        target.append(oracle.waypoint(bank.scenes[bank.scene_index[i]], pose, home_pose))
+        current.append(i)
+        home.append(j)
+        bar.update()
+    bar.close()
+    return PairSet(np.asarray(current), np.asarray(home), np.asarray(target, dtype=float))
+
+
+def rolled(panoramas: np.ndarray, columns: np.ndarray) -> np.ndarray:
+    """``panoramas[n]`` rolled by ``columns[n]`` columns (``np.roll`` along azimuth): the
+    view at the same place after turning ``columns[n] * 2 pi / W`` radians
+    counter-clockwise."""
+    n, height, width, _ = panoramas.shape
+    cols = (np.arange(width)[None, :] - columns[:, None]) % width
+    return panoramas[np.arange(n)[:, None, None], np.arange(height)[None, :, None],
+                     cols[:, None, :]]
+
+
+def pair_labels(bank: PoseBank, pairs: PairSet, p: np.ndarray, k: np.ndarray, oracle,
+                helper: MotionHelper) -> np.ndarray:
+    """The oracle's first action for pairs ``p`` with the robot at heading ``k`` columns
+    (``k * 2 pi / W`` radians, counter-clockwise)."""
+    width = bank.panoramas.shape[2]
+    labels = []
+    for pair, column in zip(p, k):
+        pose = (*bank.positions[pairs.current[pair]], column * 2 * math.pi / width)
+        actions = helper.plan(oracle.move_to(pose, pairs.target[pair]))
+        labels.append(actions[0] if actions else helper.stop_action())
+    return np.asarray(labels)
+
+
+def pair_samples(bank: PoseBank, pairs: PairSet, count: int, oracle, helper: MotionHelper,
+                 rng: np.random.Generator) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """``count`` samples: a random pair with random current and home headings (whole
+    columns), as observations ``{"panorama", "goal"}`` and the oracle's first action."""
+    width = bank.panoramas.shape[2]
+    p = rng.integers(len(pairs.current), size=count)
+    k = rng.integers(width, size=count)
+    m = rng.integers(width, size=count)
+    observations = {"panorama": rolled(bank.panoramas[pairs.current[p]], k),
+                    "goal": rolled(bank.panoramas[pairs.home[p]], m)}
+    return observations, pair_labels(bank, pairs, p, k, oracle, helper)
+
+
+def agreement(model, observations: dict[str, np.ndarray], labels: np.ndarray,
+              batch_size: int = 512) -> float:
+    """Share of samples whose deterministic policy action equals the label."""
+    hits = 0
+    for start in range(0, len(labels), batch_size):
+        batch = {k: v[start:start + batch_size] for k, v in observations.items()}
+        actions, _ = model.predict(batch, deterministic=True)
+        hits += int(np.sum(np.all(np.reshape(actions == labels[start:start + batch_size],
+                                             (len(actions), -1)), axis=1)))
+    return hits / len(labels)
+
+
+def pretrain(model, env_id: str, env_kwargs: dict, positions: int, scenes: int,
+             samples: int, seed: int, chunk: int = 8192, batch_size: int = 128,
+             progress: bool = True) -> PretrainResult:
+    """Fit ``model`` (SB3 PPO with a ``{"panorama", "goal"}`` observation) to the oracle on
+    ``samples`` rendered pair samples from ``positions`` bank positions spread over
+    ``scenes`` scene instances (seeds from ``seed``); validation pairs come from a
+    separate bank of a quarter of the size (seeds from ``seed + scenes``)."""
+    if positions < 2 * scenes or scenes < 1 or samples < 1:
+        raise ValueError(f"pretraining needs scenes >= 1, positions >= 2 per scene and "
+                         f"samples >= 1, got positions={positions}, scenes={scenes}, "
+                         f"samples={samples}")
+    env = gym.make(env_id, **env_kwargs)
+    keys = tuple(env.observation_space.spaces)
+    if sorted(keys) != sorted(BANK_KEYS):
+        env.close()
+        raise ValueError(f"pretraining on pose pairs needs obs_keys {BANK_KEYS}, the env "
+                         f"has {keys}")
+    oracle = baselines.make("oracle")
+    prepare_policy(oracle, env)
+    helper = MotionHelper(oracle.motion_spec, oracle.motion)
+    task = env.unwrapped.task
+    distance = (task.success_radius, task.start_distance[1])
+    rng = np.random.default_rng(seed)
+    try:
+        per_scene = positions // scenes
+        bank = render_bank(env, per_scene, scenes, seed, progress)
+        check = render_bank(env, max(per_scene // 4, 2), scenes, seed + scenes, progress)
+    finally:
+        env.close()
+    pairs = pair_set(bank, 8 * positions, distance, oracle, rng, progress)
+    check_pairs = pair_set(check, 2 * len(check.positions), distance, oracle, rng, progress)
+    check_obs, check_labels = pair_samples(check, check_pairs, 4096, oracle, helper, rng)
+    result = PretrainResult(positions=len(bank.positions), pairs=len(pairs.current))
+    done = 0
+    bar = tqdm(total=samples, desc="pretraining on pose pairs", disable=not progress)
+    while done < samples:
+        n = min(chunk, samples - done)
+        observations, labels = pair_samples(bank, pairs, n, oracle, helper, rng)
+        result.loss.append(fit(model, observations, labels, 1, batch_size, rng))
+        done += n
+        result.samples.append(done)
+        result.agreement.append(agreement(model, check_obs, check_labels))
+        bar.update(n)
+        bar.set_postfix(loss=f"{result.loss[-1]:.3f}", agree=f"{result.agreement[-1]:.2f}")
+    bar.close()
+    return result
