@@ -288,8 +288,8 @@ class LandmarkNavigationEnv(HomingEnv):
     """## Description
 
     Landmark navigation (Briggs, Scharstein et al. 2000, §4). Barcoded self-similar
-    landmarks hang on the walls of the ``corridors`` scene (four rooms off a corridor, 12
-    panels with ids 0-11; :mod:`homing_gym.selfsimilar`). The goal is a landmark id; the
+    landmarks hang on the walls of the ``corridors`` scene (four rooms off a corridor, 14
+    panels with ids 0-13; :mod:`homing_gym.selfsimilar`). The goal is a landmark id; the
     robot must go and stand in front of that landmark, using only what it sees. The
     robot knows the landmark design (the pattern, the barcode, the panel size), not the
     map: a method learns where landmarks are by exploring (the paper's visibility graph,
@@ -310,7 +310,7 @@ class LandmarkNavigationEnv(HomingEnv):
 
     | key | space | meaning |
     |---|---|---|
-    | `goal_id` | `Box(0, 1, (32,), float32)` | one-hot id of the goal landmark (ids 0-31, all a barcode can carry) |
+    | `goal_id` | `Box(0, 1, (31,), float32)` | one-hot id of the goal landmark (ids 0-30, all a barcode can carry) |
     | `view` | `Box(0, 255, (h, w, 3), uint8)` | forward perspective camera at the panoramic camera's place: ``view_size`` = (320, 240) pixels, ``view_hfov_deg`` = 60 (Briggs et al. use 320 x 240 and 640 x 480 images) |
 
     The panorama follows the usual convention (column ``x`` has bearing

@@ -44,11 +44,14 @@ import numpy as np
 
 #: The paper's scale factor (Fig. 3, Fig. 5).
 DEFAULT_P = 2 / 3
-#: Identity bits of the barcode: ids 0 .. 2**ID_BITS - 1.
+#: Identity bits of the barcode.
 ID_BITS = 5
 #: Bands of the barcode column: guard, ID_BITS bits, parity, guard.
 BARCODE_BANDS = ID_BITS + 3
-MAX_ID = 2 ** ID_BITS - 1
+#: Largest id: ``2**ID_BITS - 2``. The all-ones id would be an all-dark column, which any
+#: dark area next to a pattern-like texture reads as a valid code (rendered corridors gave
+#: such false ids); :func:`decode_barcode` therefore rejects it.
+MAX_ID = 2 ** ID_BITS - 2
 #: Bumped whenever the drawing changes, so stale cached PNGs are not reused.
 TEXTURE_VERSION = 1
 
@@ -86,9 +89,10 @@ def barcode_bits(landmark_id: int) -> list[int]:
 
 def decode_barcode(bands) -> int | None:
     """The id encoded by ``BARCODE_BANDS`` band values (1 = dark), or ``None`` when the
-    guards or the parity do not check."""
+    guards or the parity do not check or every band is dark (see :data:`MAX_ID`)."""
     bands = [int(b) for b in bands]
-    if len(bands) != BARCODE_BANDS or bands[0] != 1 or bands[-1] != 1:
+    if (len(bands) != BARCODE_BANDS or bands[0] != 1 or bands[-1] != 1
+            or all(bands)):
         return None
     bits = bands[1:1 + ID_BITS]
     if sum(bits) % 2 != bands[1 + ID_BITS]:

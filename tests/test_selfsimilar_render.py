@@ -58,7 +58,7 @@ def test_detector_finds_a_rendered_landmark_at_2m(env, size, cfg, angle):
 
 
 def test_render_view_leaves_the_episode_alone(env):
-    pose, pano = env.pose.copy(), env._panorama.copy()
+    pose, pano = env.pose.copy(), env.panorama.copy()
     env.render_view(_viewpoint(1.0, 30), size=(160, 120))
     assert np.array_equal(env.pose, pose)
     assert np.array_equal(env.render_panorama(env.sim.robot.pose()), pano)
@@ -74,3 +74,31 @@ def test_corridors_scene_has_unique_barcoded_panels():
     assert len(panels) >= 8
     ids = sorted(scene.metadata["landmarks"])
     assert ids == list(range(len(panels)))
+
+
+def test_corridors_visibility_graph_is_connected_on_rendered_scans():
+    """From each room panel's standing place, a rendered scan (12 views, the controller's
+    detector) finds a panel outside the room, from each corridor panel's another
+    corridor panel, and every panel can be reached from every other one over the edges
+    found (Briggs et al. §4.1)."""
+    import gymnasium as gym
+    import networkx as nx
+
+    from train.selfsimilar_figures import panel_area, scan_visibility
+
+    e = gym.make("homing_gym/LandmarkNavigation-v0")
+    try:
+        e.reset(seed=0)
+        seen = scan_visibility(e)
+        scene = e.unwrapped.scene
+    finally:
+        e.close()
+    ids = set(scene.metadata["landmarks"])
+    assert set(seen) == ids
+    corridor = len(scene.metadata["rooms"]) - 1          # the last area is the corridor
+    for a, bs in seen.items():
+        area = panel_area(scene, a)
+        assert any(panel_area(scene, b) != area or area == corridor
+                   for b in bs if b in ids), (a, bs)
+    graph = nx.DiGraph([(a, b) for a, bs in seen.items() for b in bs if b in ids])
+    assert set(graph) == ids and nx.is_strongly_connected(graph)

@@ -2,6 +2,7 @@
 
     python -m train.selfsimilar_figures speed --out docs/selfsimilar
     python -m train.selfsimilar_figures detection --out docs/selfsimilar
+    python -m train.selfsimilar_figures layout --out docs/selfsimilar
 
 ``speed``: detector frame rate on one core at 640 x 480 and 320 x 240 (the paper's
 sizes), with and without the §3.3 speed-ups (every 2k-th scanline first; peak scan
@@ -18,6 +19,13 @@ board just in front of the panel hiding the left 10, 25 or 50 % of the pattern, 
 the self-similarity origin on). A hit: id 5 among the detections; a false positive:
 any other detection. Writes ``detection.json`` and ``detection.png`` under ``--out``
 and prints Markdown tables.
+
+``layout``: the visibility graph of the ``corridors`` scene as the ``selfsimilar``
+controller would find it (§4.1): from each panel's standing place (1 m out along its
+normal) a full turn of 12 rendered 320 x 240 views, 30 degrees apart, each searched by
+the detector; an edge ``a -> b`` when ``b`` is detected from ``a``'s standing place.
+Writes ``layout.json`` (edges, the area of each panel, whether the graph is strongly
+connected) and prints the edges.
 """
 
 from __future__ import annotations
@@ -228,16 +236,82 @@ def detection_figure(rows: list[dict], path: str) -> None:
     plt.close(fig)
 
 
+#: The controller's standing place (m out along a panel's normal) and scan step (degrees).
+STANDOFF, SCAN_STEP = 1.0, 30
+
+
+def panel_area(scene, landmark_id: int) -> int:
+    """Index of the room (``scene.metadata["rooms"]``) a panel faces into."""
+    x, y, normal = scene.metadata["landmarks"][landmark_id]
+    px, py = x + 0.3 * math.cos(normal), y + 0.3 * math.sin(normal)
+    for i, ((x0, y0), (x1, y1)) in enumerate(scene.metadata["rooms"]):
+        if x0 <= px <= x1 and y0 <= py <= y1:
+            return i
+    raise ValueError(f"panel {landmark_id} faces no room of scene {scene.name!r}")
+
+
+def scan_visibility(env) -> dict[int, list[int]]:
+    """``{a: ids detected in a full turn from a's standing place}`` in ``env``'s scene
+    (a ``LandmarkNavigation-v0`` env after ``reset``), as :data:`VIEW_DETECTOR` sees
+    the rendered views."""
+    from homing_gym.tasks.landmark_navigation import standing_pose
+
+    u = env.unwrapped
+    model = PerspectiveModel.from_fov(*VIEW_SIZE, VIEW_HFOV)
+    seen = {}
+    for a, panel in sorted(u.scene.metadata["landmarks"].items()):
+        x, y, heading = standing_pose(panel, STANDOFF)
+        ids: set[int] = set()
+        for turn in range(0, 360, SCAN_STEP):
+            pose = np.array([x, y, heading + math.radians(turn)])
+            image = u.render_view(pose, size=VIEW_SIZE, hfov_deg=math.degrees(VIEW_HFOV))
+            ids.update(d.id for d in detect_landmarks(image, model, VIEW_DETECTOR))
+        seen[a] = sorted(ids - {a})
+    return seen
+
+
+def measure_layout() -> dict:
+    """:func:`scan_visibility` in the ``corridors`` scene, with the areas and whether
+    every panel can reach every other one over the edges."""
+    import gymnasium as gym
+    import networkx as nx
+
+    import homing_gym
+
+    gym.register_envs(homing_gym)
+    env = gym.make("homing_gym/LandmarkNavigation-v0")
+    env.reset(seed=0)
+    try:
+        seen = scan_visibility(env)
+        scene = env.unwrapped.scene
+        areas = {a: panel_area(scene, a) for a in seen}
+    finally:
+        env.close()
+    graph = nx.DiGraph([(a, b) for a, bs in seen.items() for b in bs])
+    graph.add_nodes_from(seen)
+    return {"seen": {str(a): b for a, b in seen.items()},
+            "areas": {str(a): i for a, i in areas.items()},
+            "strongly_connected": nx.is_strongly_connected(graph)}
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m train.selfsimilar_figures",
                                      description=__doc__.split("\n")[0])
-    parser.add_argument("what", choices=["speed", "detection"])
+    parser.add_argument("what", choices=["speed", "detection", "layout"])
     parser.add_argument("--out", default="docs/selfsimilar")
     parser.add_argument("--repeats", type=int, default=20)
     args = parser.parse_args(argv)
     if args.repeats < 1:
         parser.error(f"--repeats must be >= 1, got {args.repeats}")
     os.makedirs(args.out, exist_ok=True)
+    if args.what == "layout":
+        result = measure_layout()
+        with open(os.path.join(args.out, "layout.json"), "w") as f:
+            json.dump(result, f, indent=1)
+        for a, bs in result["seen"].items():
+            print(f"{a} (area {result['areas'][a]}) sees {bs}")
+        print("strongly connected:", result["strongly_connected"])
+        return 0
     if args.what == "detection":
         rows = measure_detection()
         with open(os.path.join(args.out, "detection.json"), "w") as f:

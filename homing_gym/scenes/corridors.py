@@ -3,12 +3,13 @@
 
 An 8 x 6 m floor: four 4 x 2.4 m rooms, two south (A, B) and two north (C, D) of a
 1.2 m wide corridor running east-west (y from 2.4 to 3.6 m), each room opening onto it
-through a 0.9 m door. Walls are 1.2 m high and light grey, the floor light grey
+through a 1.2 m door. Walls are 1.2 m high and light grey, the floor light grey
 (the detector's barcode reader needs light surroundings, see
-:mod:`baselines.selfsimilar_detector`). Twelve landmark panels
-(:func:`wall_panel`, :mod:`homing_gym.selfsimilar`, ids 0-11) hang on the walls with
-the pattern centred at camera height: two in each room, one on each end wall of the
-corridor and one on each of its side walls, halfway. ``scene.metadata``:
+:mod:`baselines.selfsimilar_detector`). Fourteen landmark panels
+(:func:`wall_panel`, :mod:`homing_gym.selfsimilar`, ids 0-13) hang on the walls with
+the pattern centred at camera height: two in each room on the wall facing its door, one
+on each end wall of the corridor and one opposite each door (see :data:`PANELS`: the
+visibility graph is connected). ``scene.metadata``:
 
 * ``"landmarks"``: ``{id: (x, y, yaw_in)}``, the centre of each panel's front face and
   the direction (radians) of its normal into the room;
@@ -25,25 +26,34 @@ from homing_gym.selfsimilar import DEFAULT_P, PanelLayout, panel_texture_path
 
 WIDTH, DEPTH = 8.0, 6.0
 CORRIDOR = (2.4, 3.6)
-DOOR = 0.9
+DOOR = 1.2
 WALL_HEIGHT, WALL_T = 1.2, 0.05
 WALL_COLOR = (0.9, 0.9, 0.88, 1.0)
 FLOOR_COLOR = (0.75, 0.75, 0.73, 1.0)
 PANEL_DEPTH = 0.02
 #: Height (m) of the pattern's centre above the floor: the camera's height.
 PANEL_CENTRE_HEIGHT = 0.30
-#: Door centres (x) on the south and north corridor walls.
-DOORS_SOUTH = (2.0, 6.0)
-DOORS_NORTH = (1.4, 6.6)
+#: Door centres (x) on the south (rooms A, B) and north (C, D) corridor walls.
+DOORS_SOUTH = (2.0, 6.1)
+DOORS_NORTH = (3.0, 5.0)
 #: Landmark panels: (id, x, y, direction of the wall normal into the room, degrees).
-#: (x, y) is on the wall surface, the centre of the panel.
+#: (x, y) is on the wall surface, the centre of the panel. Each room's two panels hang on
+#: the wall facing its door, 0.6 m either side of the door's axis; each door faces a
+#: corridor panel on the opposite corridor wall. From a room panel's standing place (1 m
+#: out) the robot sees that corridor panel through the door and from the corridor
+#: panel's standing place (in the doorway) both room panels; the corridor's end panels
+#: see along the corridor. So every panel is reachable from every other one over the
+#: visibility graph (§4.1), as in the paper's environment, where landmarks are seen from
+#: room to corridor and along it (checked on rendered views by
+#: ``python -m train.selfsimilar_figures layout`` and ``tests/test_selfsimilar_render.py``).
 PANELS = (
-    (0, 1.0, 0.0, 90), (1, 0.0, 1.4, 0),           # room A (south-west)
-    (2, 6.5, 0.0, 90), (3, 8.0, 1.2, 180),         # room B (south-east)
-    (4, 0.0, 4.8, 0), (5, 2.6, 6.0, -90),          # room C (north-west)
-    (6, 5.0, 6.0, -90), (7, 8.0, 4.8, 180),        # room D (north-east)
+    (0, 1.4, 0.0, 90), (1, 2.6, 0.0, 90),          # room A (south-west)
+    (2, 5.5, 0.0, 90), (3, 6.7, 0.0, 90),          # room B (south-east)
+    (4, 2.4, 6.0, -90), (5, 3.55, 6.0, -90),       # room C (north-west)
+    (6, 4.45, 6.0, -90), (7, 5.6, 6.0, -90),       # room D (north-east)
     (8, 0.0, 3.0, 0), (9, 8.0, 3.0, 180),          # corridor end walls
-    (10, 4.0, 2.4, 90), (11, 4.0, 3.6, -90),       # corridor side walls, halfway
+    (10, 2.0, 3.6, -90), (11, 3.0, 2.4, 90),       # corridor, facing the doors of A, C
+    (12, 5.0, 2.4, 90), (13, 6.1, 3.6, -90),       # ... of D, B
 )
 
 
