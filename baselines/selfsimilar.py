@@ -22,8 +22,9 @@ What it does (the modes of §4):
 2. **Away from any landmark** (the start, or after losing its way) it scans and goes to
    the goal if it saw it, else to the nearest landmark seen (§4.2: "it moves to the
    nearest visible landmark"), preferring ones it has not scanned from; with nothing
-   in sight it drives ``wander_distance`` in a random direction (seeded by the
-   episode) and scans again.
+   in sight it dead-reckons as at a landmark (3), and only with no landmark to go to
+   drives ``wander_distance`` in a random direction (seeded by the episode) and scans
+   again.
 3. **At landmark A** (after servoing to its standing place): the scan result updates
    the graph (:meth:`VisibilityGraph.observe`: edges with distance, angle, looked/seen
    counts). Then
@@ -33,9 +34,16 @@ What it does (the modes of §4):
    *probabilistic* (§4.3): with ``E`` the expected shortest lengths (value iteration,
    stay cost ``look_cost``), head for the visible landmark minimising ``l_Ay + E_y``, or
    stay and scan again.
-   If the goal is not reachable in the graph yet: explore (§4.1), i.e. go to the closest
+   If the goal is not reachable from A in the graph: **dead reckoning** (§4.2, "the robot
+   uses dead reckoning to navigate to the closest landmark from which the destination
+   is reachable"): every landmark seen has a position in the robot's own frame (from
+   the pose, the global angle and the distance of its sightings, refined while
+   servoing); the robot drives towards the closest landmark (straight-line distance)
+   from which the goal is reachable, the goal itself included once seen, until it sees
+   it and servos to it. If there is none: explore (§4.1), i.e. go to the closest
    landmark not scanned from yet, by edge lengths plus ``look_cost`` per landmark on
-   the way, hop by hop as in navigation.
+   the way, hop by hop as in navigation; if every landmark of the graph was scanned
+   from, dead-reckon to the closest one known that was not.
 4. **Visual servoing** to a landmark: detect it in every view, measure the panel's
    centre and normal (:func:`~baselines.selfsimilar_panel.panel_pose`) and step
    towards its standing place ``standoff`` m out along the normal, facing it; the
@@ -43,7 +51,12 @@ What it does (the modes of §4):
    is turned to (its last position by dead reckoning); one not found where it should be
    is searched for by a scan; if the scan does not find it either the robot is away
    from any landmark again (2).
-5. **Finish**: at the goal's standing place it stops (``None``); should the env not have
+5. **Blocked** (no obstacle sensor; §4 leaves local obstacle avoidance to the robot's
+   sensors): a drive after which the view has hardly changed (``BLOCKED_CHANGE``; the
+   wheels slip, so the odometry cannot tell) ran into a wall or door frame; the robot
+   backs off ``SIDESTEP`` m, side-steps as far (to the left and right alternately) and
+   servos on; after ``MAX_BLOCKS`` blocked drives in a row it scans.
+6. **Finish**: at the goal's standing place it stops (``None``); should the env not have
    ended the episode (its success test is stricter than the estimate), it servos again,
    at most ``MAX_REFINES`` times, then stops for good.
 
@@ -62,8 +75,10 @@ Choices where the paper is silent (also in ``docs/selfsimilar.md``):
   information to recalibrate its direction"): at a landmark scanned from before, the
   heading is corrected by the mean difference between the stored and the measured
   global angles of the landmarks seen again (if it is below ``MAX_RECALIBRATION``).
-* *Dead reckoning to the closest landmark from which the goal is reachable* (§4.2,
-  when no plan exists) is not implemented: the robot explores (or wanders) instead.
+* *Dead reckoning* (§4.2) also serves exploration (to an unexplored landmark not
+  reachable over the graph) and a robot that sees nothing. A landmark not found where
+  dead reckoning puts it is not tried again until the robot next reaches a landmark.
+  The robot has no obstacle sensor: a straight dead-reckoned leg may run into a wall.
 * *Costs*: edge lengths are metres; ``look_cost`` (m) is both the scan time of §4.1's
   exploration distance and the stay cost ``l_xx`` of §4.3.
 """
@@ -96,6 +111,12 @@ MAX_MISSES = 2
 MAX_RECALIBRATION = math.radians(30)
 #: Distance (m) to the standing place and angle (rad) to the panel at which it is reached.
 ARRIVE_DISTANCE, ARRIVE_ANGLE = 0.12, math.radians(10)
+#: A drive after which the view changed by less than this mean absolute intensity
+#: ([0, 1]) ran into something (the wheels slip, so odometry does not tell; drives of
+#: 0.5 m change rendered views by 0.03-0.2, a blocked robot's by 0.01-0.02); the robot
+#: then backs off ``SIDESTEP`` m and side-steps as far, at most ``MAX_BLOCKS`` times in
+#: a row before it gives up its target and scans.
+BLOCKED_CHANGE, SIDESTEP, MAX_BLOCKS = 0.025, 0.3, 4
 
 
 @dataclass
@@ -191,6 +212,13 @@ class SelfSimilarController(Controller):
         self._centre: np.ndarray | None = None   # target panel centre, own frame (m)
         self._normal: float | None = None        # its normal, own frame (rad)
         self._refines = 0
+        #: Own-frame position (m) of every landmark seen, for dead reckoning (§4.2).
+        self.positions: dict[int, np.ndarray] = {}
+        self._reckoning = False                  # servoing towards a remembered position
+        self._lost: set[int] = set()             # not found where dead reckoning put them
+        self._before_drive: np.ndarray | None = None  # the view when the last drive began
+        self._blocks = 0
+        self._escape: list[Move] = []            # queued moves out of a blocked drive
 
     # -- decisions --------------------------------------------------------------------------
     def decide(self, observation: dict[str, np.ndarray]) -> Move | None:
@@ -204,6 +232,21 @@ class SelfSimilarController(Controller):
         model = PerspectiveModel.from_fov(gray.shape[1], gray.shape[0],
                                           math.radians(self.view_hfov_deg))
         self._now = {d.id: d for d in detect_landmarks(gray, model, self._detector)}
+        move = self._choose(gray, model, goal)
+        self._before_drive = gray if move is not None and move.distance > 0 else None
+        return move
+
+    def _choose(self, gray, model, goal: int) -> Move | None:
+        if self._escape:
+            return self._escape.pop(0)
+        if self._blocked(gray):
+            self._blocks += 1
+            if self._blocks <= MAX_BLOCKS:
+                side = math.pi / 2 if self._blocks % 2 else -math.pi / 2
+                self._escape = [Move(side, SIDESTEP)]
+                return Move(math.pi, SIDESTEP)
+            self._blocks = 0
+            return self._start_scan(goal)
         if self._scan is not None:
             return self._scanning(goal)
         if self._look is not None:
@@ -230,6 +273,16 @@ class SelfSimilarController(Controller):
             self._travelled += math.hypot(dx, dy)
         self._odometry = odometry.copy()
 
+    def _blocked(self, gray: np.ndarray) -> bool:
+        """Whether the last drive left the view ``gray`` (nearly) as it was (see
+        ``BLOCKED_CHANGE``); a drive that changed it ends a run of blocked ones."""
+        if self._before_drive is None:
+            return False
+        if float(np.mean(np.abs(gray - self._before_drive))) >= BLOCKED_CHANGE:
+            self._blocks = 0
+            return False
+        return True
+
     def _to_robot(self, point: np.ndarray) -> np.ndarray:
         d = point - self._pose[:2]
         c, s = math.cos(self._pose[2]), math.sin(self._pose[2])
@@ -252,9 +305,10 @@ class SelfSimilarController(Controller):
         for landmark, det in self._now.items():
             old = scan.seen.get(landmark)
             if old is None or abs(det.bearing) < old.offset:
-                scan.seen[landmark] = Sighting(det.distance,
-                                               wrap_angle(self._pose[2] + det.bearing),
-                                               abs(det.bearing))
+                angle = wrap_angle(self._pose[2] + det.bearing)
+                scan.seen[landmark] = Sighting(det.distance, angle, abs(det.bearing))
+                self.positions[landmark] = self._pose[:2] + det.distance * np.array(
+                    [math.cos(angle), math.sin(angle)])
         scan.views_left -= 1
         if scan.views_left > 0:
             return Move(math.radians(self.scan_step_deg), 0.0)
@@ -262,6 +316,8 @@ class SelfSimilarController(Controller):
         if self._target is not None:          # a search for the servo target
             if self._target in scan.seen:
                 return self._head_for(self._target, scan.seen[self._target])
+            if self._reckoning:
+                self._lost.add(self._target)
             self._target = self._came_from = None
             self.at = None
         if self.at is None:
@@ -285,9 +341,9 @@ class SelfSimilarController(Controller):
 
     def _leave_nowhere(self, seen: dict[int, Sighting], goal: int) -> Move:
         """Away from landmarks: to the goal if seen, else the nearest one (§4.2), one
-        not scanned from yet if any is seen; else wander."""
+        not scanned from yet if any is seen; else dead reckoning or wander."""
         if not seen:
-            return self._wander()
+            return self._reckon_or_wander(goal)
         new = [b for b in seen if b not in self.explored] or list(seen)
         target = goal if goal in seen else min(new, key=lambda b: seen[b].distance)
         self._came_from = None
@@ -308,17 +364,55 @@ class SelfSimilarController(Controller):
             path = self.graph.shortest_path(here, goal)
             if path is not None:
                 return self._look_for(path[1])
+        reaching = self._reaching(goal) - {here}
+        if reaching:
+            return self._reckon_to(reaching)
         hop = self._exploration_hop(here)
         if hop is not None:
             return self._look_for(hop)
         return self._scan_again(goal)
+
+    def _reaching(self, goal: int) -> set[int]:
+        """Landmarks with a known position, not lost, from which the goal is reachable
+        (deterministic: over edges believed visible; probabilistic: finite expected
+        length)."""
+        if self.planning == "probabilistic":
+            values = (self.graph.expected_lengths(goal, self.look_cost)
+                      if goal in self.graph.graph else {})
+            found = {x for x, v in values.items() if math.isfinite(v)}
+        else:
+            found = self.graph.reaching(goal)
+        if goal in self.positions:
+            found.add(goal)
+        return {x for x in found if x in self.positions and x not in self._lost}
+
+    def _reckon_or_wander(self, goal: int) -> Move:
+        """No landmark to servo to: dead reckoning (§4.2) to the closest landmark from
+        which the goal is reachable, else to the closest one not scanned from; else
+        wander."""
+        here = {self.at} if self.at is not None else set()
+        for options in (self._reaching(goal) - here,
+                        set(self.positions) - self.explored - self._lost - here):
+            if options:
+                return self._reckon_to(options)
+        return self._wander()
+
+    def _reckon_to(self, options: set[int]) -> Move:
+        """Drive towards the closest of ``options`` by its remembered position."""
+        target = min(options, key=lambda b: float(np.hypot(*(self.positions[b]
+                                                             - self._pose[:2]))))
+        self._target, self._centre, self._normal = target, self.positions[target].copy(), None
+        self.at, self._came_from, self._reckoning = None, None, True
+        self._travelled, self._scans_here, self._misses = 0.0, 0, 0
+        centre = self._to_robot(self._centre)
+        return Move(math.atan2(centre[1], centre[0]), 0.0)
 
     def _scan_again(self, goal: int) -> Move:
         """Stay and scan again (§4.3), unless this landmark was scanned from
         ``MAX_SCANS_HERE`` times since the robot came: then wander off."""
         if self._scans_here < MAX_SCANS_HERE:
             return self._start_scan(goal)
-        return self._wander()
+        return self._reckon_or_wander(goal)
 
     def _wander(self) -> Move:
         """Nothing to go to: ``wander_distance`` in a random direction."""
@@ -357,6 +451,7 @@ class SelfSimilarController(Controller):
         """Start servoing to ``landmark`` seen at ``sighting``: turn towards it."""
         self._target, self._normal, self.at = landmark, None, None
         self._travelled, self._scans_here, self._misses = 0.0, 0, 0
+        self._reckoning = False
         direction = np.array([math.cos(sighting.angle), math.sin(sighting.angle)])
         self._centre = self._pose[:2] + sighting.distance * direction
         return Move(wrap_angle(sighting.angle - self._pose[2]), 0.0)
@@ -364,7 +459,7 @@ class SelfSimilarController(Controller):
     def _servo(self, gray, model, goal: int) -> Move | None:
         det = self._now.get(self._target)
         if det is not None:
-            self._misses = 0
+            self._misses, self._reckoning = 0, False
             self._update_target(gray, model, det)
         elif self._centre is None:
             return self._start_scan(goal)
@@ -385,7 +480,7 @@ class SelfSimilarController(Controller):
         if det is None or np.hypot(*aim) < ARRIVE_DISTANCE:  # lost, or no normal yet
             self._misses += 1
             closer = distance - self.standoff - 0.2
-            if self._misses > MAX_MISSES or closer <= 0:
+            if (self._misses > MAX_MISSES and not self._reckoning) or closer <= 0:
                 self._misses = 0
                 return self._start_scan(goal)  # not where it should be: search
             return Move(bearing, min(self.step_length, closer))  # too far to read?
@@ -398,8 +493,10 @@ class SelfSimilarController(Controller):
         if pose is None:
             self._centre = self._to_own(det.distance * np.array(
                 [math.cos(det.bearing), math.sin(det.bearing)]))
+            self.positions[self._target] = self._centre.copy()
             return
         self._centre = self._to_own(pose.centre)
+        self.positions[self._target] = self._centre.copy()
         normal = pose.normal + self._pose[2]
         if self._normal is not None:
             normal = math.atan2(math.sin(normal) + math.sin(self._normal),
@@ -415,6 +512,7 @@ class SelfSimilarController(Controller):
         self.at, self._target, self._came_from = landmark, None, None
         self._centre = self._normal = None
         self._scans_here = 0
+        self._lost.clear()
         if landmark == goal:
             return None
         if self.planning == "probabilistic" or landmark not in self.explored:

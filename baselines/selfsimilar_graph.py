@@ -108,6 +108,15 @@ class VisibilityGraph:
         except nx.NetworkXNoPath:
             return None
 
+    def reaching(self, goal: int) -> set[int]:
+        """The landmarks from which a path over edges believed visible leads to
+        ``goal`` (``goal`` itself included, if known)."""
+        if goal not in self.graph:
+            return set()
+        usable = nx.subgraph_view(
+            self.graph, filter_edge=lambda a, b: self.graph[a][b]["info"].visible)
+        return nx.ancestors(usable, goal) | {goal}
+
     def expected_lengths(self, goal: int, stay_cost: float, tolerance: float = 1e-6,
                          max_iterations: int = 10_000) -> dict[int, float]:
         """``E_x`` (m) for every node (§4.3), by value iteration; ``inf`` where the goal
