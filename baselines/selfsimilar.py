@@ -117,6 +117,9 @@ ARRIVE_DISTANCE, ARRIVE_ANGLE = 0.12, math.radians(10)
 #: then backs off ``SIDESTEP`` m and side-steps as far, at most ``MAX_BLOCKS`` times in
 #: a row before it gives up its target and scans.
 BLOCKED_CHANGE, SIDESTEP, MAX_BLOCKS = 0.025, 0.3, 4
+#: A move that turns by more than this (radians) before driving is made as two, the turn
+#: and then the drive, so that the view before the drive tells whether it was blocked.
+SPLIT_TURN = math.radians(5)
 
 
 @dataclass
@@ -219,6 +222,7 @@ class SelfSimilarController(Controller):
         self._before_drive: np.ndarray | None = None  # the view when the last drive began
         self._blocks = 0
         self._escape: list[Move] = []            # queued moves out of a blocked drive
+        self._pending: Move | None = None        # the drive after a split-off turn
 
     # -- decisions --------------------------------------------------------------------------
     def decide(self, observation: dict[str, np.ndarray]) -> Move | None:
@@ -233,10 +237,17 @@ class SelfSimilarController(Controller):
                                           math.radians(self.view_hfov_deg))
         self._now = {d.id: d for d in detect_landmarks(gray, model, self._detector)}
         move = self._choose(gray, model, goal)
+        if move is not None and move.distance > 0 and abs(move.direction) > SPLIT_TURN:
+            self._pending = Move(0.0, move.distance)
+            move = Move(move.direction, 0.0)
         self._before_drive = gray if move is not None and move.distance > 0 else None
         return move
 
     def _choose(self, gray, model, goal: int) -> Move | None:
+        if self._pending is not None and not self._blocked(gray):
+            move, self._pending = self._pending, None
+            return move
+        self._pending = None
         if self._escape:
             return self._escape.pop(0)
         if self._blocked(gray):
