@@ -3,6 +3,7 @@
     python -m train.selfsimilar_figures speed --out docs/selfsimilar
     python -m train.selfsimilar_figures detection --out docs/selfsimilar
     python -m train.selfsimilar_figures layout --out docs/selfsimilar
+    python -m train.selfsimilar_figures nav --runs RUNS --out docs/selfsimilar
 
 ``speed``: detector frame rate on one core at 640 x 480 and 320 x 240 (the paper's
 sizes), with and without the §3.3 speed-ups (every 2k-th scanline first; peak scan
@@ -26,6 +27,12 @@ normal) a full turn of 12 rendered 320 x 240 views, 30 degrees apart, each searc
 the detector; an edge ``a -> b`` when ``b`` is detected from ``a``'s standing place.
 Writes ``layout.json`` (edges, the area of each panel, whether the graph is strongly
 connected) and prints the edges.
+
+``nav``: merges the ``homing-eval`` results of ``LandmarkNavigation-v0`` run in chunks
+of seeds, ``RUNS/nav_<planning>_<clean|changed>_s<first seed>.json``, into
+``nav_<planning>_<clean|changed>.json`` (+ .csv) under ``--out`` and prints the
+results table: success with its 95 % bootstrap interval (:func:`train.metrics.bootstrap_ci`),
+median path length and shortest path of the successes, steps, collisions.
 """
 
 from __future__ import annotations
@@ -294,16 +301,71 @@ def measure_layout() -> dict:
             "strongly_connected": nx.is_strongly_connected(graph)}
 
 
+PLANNINGS, CONDITIONS = ("deterministic", "probabilistic"), ("clean", "changed")
+
+
+def merge_nav_runs(runs: str, out: str) -> dict:
+    """Merge the chunks of each planning x condition (see the module docstring); the
+    merged result's seed is the smallest chunk's."""
+    import glob
+
+    from train.evaluate import EvalResult
+
+    merged = {}
+    for planning in PLANNINGS:
+        for condition in CONDITIONS:
+            paths = glob.glob(os.path.join(runs, f"nav_{planning}_{condition}_s*.json"))
+            if not paths:
+                continue
+            parts = sorted((EvalResult.load(p) for p in paths), key=lambda r: r.seed)
+            episodes = [e for r in parts for e in r.episodes]
+            result = EvalResult(parts[0].policy, parts[0].params, parts[0].env_id,
+                                parts[0].env_kwargs, parts[0].seed, episodes)
+            result.save(os.path.join(out, f"nav_{planning}_{condition}.json"))
+            merged[(planning, condition)] = result
+    return merged
+
+
+def nav_table(merged: dict) -> str:
+    """Markdown table of merged navigation results."""
+    lines = ["| planning | landmarks | episodes (seeds) | success % [95% CI] | path length of "
+             "successes, median (m) | shortest path of successes, median (m) | steps, median "
+             "| collisions, median |", "|---|---|---:|---:|---:|---:|---:|---:|"]
+    for (planning, condition), r in merged.items():
+        ok = [e for e in r.episodes if e.success]
+        seeds = sorted(e.seed for e in r.episodes)
+        lo, hi = r.summary["success_ci"]
+        path = np.median([e.path_length for e in ok]) if ok else math.nan
+        short = np.median([e.shortest_path for e in ok]) if ok else math.nan
+        land = ("all, unoccluded" if condition == "clean"
+                else "20 % removed, 30 % occluded")
+        lines.append(
+            f"| {planning} | {land} | {len(seeds)} ({seeds[0]}-{seeds[-1]}) | "
+            f"{100 * r.summary['success_rate']:.0f} [{100 * lo:.0f}, {100 * hi:.0f}] | "
+            f"{path:.1f} | {short:.1f} | {np.median([e.steps for e in r.episodes]):.0f} | "
+            f"{np.median([e.collisions for e in r.episodes]):.0f} |")
+    return "\n".join(lines)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m train.selfsimilar_figures",
                                      description=__doc__.split("\n")[0])
-    parser.add_argument("what", choices=["speed", "detection", "layout"])
+    parser.add_argument("what", choices=["speed", "detection", "layout", "nav"])
+    parser.add_argument("--runs", help="nav: folder of the chunked homing-eval results")
     parser.add_argument("--out", default="docs/selfsimilar")
     parser.add_argument("--repeats", type=int, default=20)
     args = parser.parse_args(argv)
     if args.repeats < 1:
         parser.error(f"--repeats must be >= 1, got {args.repeats}")
     os.makedirs(args.out, exist_ok=True)
+    if args.what == "nav":
+        if not args.runs:
+            parser.error("nav needs --runs FOLDER")
+        merged = merge_nav_runs(args.runs, args.out)
+        if not merged:
+            parser.error(f"no nav_<planning>_<condition>_s<seed>.json in {args.runs!r}")
+        print(nav_table(merged))
+        return 0
     if args.what == "layout":
         result = measure_layout()
         with open(os.path.join(args.out, "layout.json"), "w") as f:
