@@ -104,8 +104,8 @@ def test_clearances_hand_computed_for_a_wall_a_box_and_a_cylinder():
                   landmarks=(Landmark((3, 0), shape="box", extent=(1.0, 0.4), yaw=math.pi / 2),
                              Landmark((-3, 3), radius=0.5)))
     points = [(0.55, 0), (0, 1.3), (3.0, -1.0), (3.3, 0), (-3, 4), (4.9, 4.9), (3, 0.2)]
-    # wall face 0.5 / 0.3 past its end less half its thickness; the box (0.4 x 1.0 once turned) 0.5 below / 0.1
-    # beside; the cylinder 0.5; the bounds 0.1; inside the box 0
+    # the wall's face 0.5 / 0.3 past its end less half its thickness; the box (0.4 x 1.0
+    # once turned) 0.5 below / 0.1 beside; the cylinder 0.5; the bounds 0.1; inside 0
     expected = [0.5, 0.25, 0.5, 0.1, 0.5, 0.1, 0.0]
     assert np.allclose(clearances(scene, points), expected)
     assert [clearance(scene, p) for p in points] == pytest.approx(expected)
