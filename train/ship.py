@@ -59,8 +59,10 @@ def ship_run(run: Path, name: str, folder: Path = POLICY_DIR, final: bool = Fals
         "env_steps_per_s": summary["env_steps_per_s"],
         "config": config,
     }
-    if (run / "imitation.json").is_file():
-        meta["imitation"] = json.loads((run / "imitation.json").read_text())
+    for warm_start in ("pretrain", "imitation"):
+        record = run / f"{warm_start}.json"
+        if record.is_file():
+            meta[warm_start] = json.loads(record.read_text())
     folder.mkdir(parents=True, exist_ok=True)
     target = folder / f"{name}.zip"
     shutil.copyfile(model, target)

@@ -60,6 +60,7 @@ class TrainConfig:
     env_kwargs: dict = field(default_factory=dict)
     eval_freq: int = 10_000
     eval_episodes: int = 20
+    eval_deterministic: bool = True
     checkpoint_freq: int = 10_000
     imitation_iterations: int = 0
     imitation_episodes: int = 40
@@ -86,6 +87,9 @@ class TrainConfig:
             value = getattr(self, key)
             if not (isinstance(value, int) and value >= 0):
                 raise ValueError(f"{key} must be an integer >= 0, got {value!r}")
+        if not isinstance(self.eval_deterministic, bool):
+            raise ValueError(f"eval_deterministic must be true or false, got "
+                             f"{self.eval_deterministic!r}")
         unknown = sorted(set(self.ppo) - set(PPO_KEYS))
         if unknown:
             raise ValueError(f"unknown PPO hyperparameters {unknown}; allowed: {list(PPO_KEYS)}")
@@ -214,6 +218,26 @@ def _restore_evaluations(callback, run: Path) -> None:
         callback.best_mean_reward = float(np.max(np.mean(data["results"], axis=1)))
 
 
+def warm_starts(config: TrainConfig, progress: bool = True) -> list[tuple[str, Any]]:
+    """The warm starts the run asks for, in order, as ``(name, fit)`` with ``fit(model)``
+    returning a dataclass record: behaviour cloning on rendered pose pairs
+    (``pretrain_samples``), then DAgger (``imitation_iterations``)."""
+    steps = []
+    if config.pretrain_samples:
+        steps.append(("pretrain", partial(
+            pretrain, env_id=config.env_id, env_kwargs=config.env_kwargs,
+            positions=config.pretrain_positions, scenes=config.pretrain_scenes,
+            samples=config.pretrain_samples, seed=config.seed + PRETRAIN_SEED_OFFSET,
+            progress=progress)))
+    if config.imitation_iterations:
+        steps.append(("imitation", partial(
+            dagger, env_id=config.env_id, env_kwargs=config.env_kwargs,
+            iterations=config.imitation_iterations, episodes=config.imitation_episodes,
+            epochs=config.imitation_epochs, seed=config.seed + IMITATION_SEED_OFFSET,
+            progress=progress)))
+    return steps
+
+
 def train(config: TrainConfig, out: Path, resume: bool = False,
           command: str | None = None, progress: bool = True):
     """Train (or, with ``resume``, continue) a run in folder ``out``; returns the model."""
@@ -246,26 +270,16 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
                                                            if config.extractor == "panorama"
                                                            else {})),
                         **config.ppo)
-            if config.pretrain_samples:
-                pretrained = pretrain(model, config.env_id, config.env_kwargs,
-                                      config.pretrain_positions, config.pretrain_scenes,
-                                      config.pretrain_samples,
-                                      config.seed + PRETRAIN_SEED_OFFSET, progress=progress)
-                (out / "pretrain.json").write_text(json.dumps(asdict(pretrained), indent=2))
-                model.save(out / "pretrain_model.zip")
-            if config.imitation_iterations:
-                imitation = dagger(model, config.env_id, config.env_kwargs,
-                                   config.imitation_iterations, config.imitation_episodes,
-                                   config.imitation_epochs,
-                                   config.seed + IMITATION_SEED_OFFSET, progress=progress)
-                (out / "imitation.json").write_text(json.dumps(asdict(imitation), indent=2))
-                model.save(out / "imitation_model.zip")
+            for name, warm_start in warm_starts(config, progress):
+                record = warm_start(model)
+                (out / f"{name}.json").write_text(json.dumps(asdict(record), indent=2))
+                model.save(out / f"{name}_model.zip")
         start_steps = model.num_timesteps
         remaining = config.timesteps - start_steps
         eval_cb = EvalCallback(eval_env, n_eval_episodes=config.eval_episodes,
                                eval_freq=max(config.eval_freq // config.n_envs, 1),
                                log_path=str(out), best_model_save_path=str(out),
-                               deterministic=True, verbose=0)
+                               deterministic=config.eval_deterministic, verbose=0)
         if checkpoint is not None:
             _restore_evaluations(eval_cb, out)
         ckpt_cb = CheckpointCallback(max(config.checkpoint_freq // config.n_envs, 1),
