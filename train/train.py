@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import platform
 import re
 import shlex
@@ -68,6 +69,7 @@ class TrainConfig:
     pretrain_samples: int = 0
     pretrain_positions: int = 4000
     pretrain_scenes: int = 1
+    warm_start_learning_rate: float = 3e-4
     ppo: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -87,6 +89,9 @@ class TrainConfig:
             value = getattr(self, key)
             if not (isinstance(value, int) and value >= 0):
                 raise ValueError(f"{key} must be an integer >= 0, got {value!r}")
+        rate = self.warm_start_learning_rate
+        if not (isinstance(rate, (int, float)) and math.isfinite(rate) and rate > 0):
+            raise ValueError(f"warm_start_learning_rate must be a positive number, got {rate!r}")
         if not isinstance(self.eval_deterministic, bool):
             raise ValueError(f"eval_deterministic must be true or false, got "
                              f"{self.eval_deterministic!r}")
@@ -271,6 +276,9 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
                                                            else {})),
                         **config.ppo)
             for name, warm_start in warm_starts(config, progress):
+                # the warm starts' own step size; PPO sets its schedule's again in train()
+                for group in model.policy.optimizer.param_groups:
+                    group["lr"] = config.warm_start_learning_rate
                 record = warm_start(model)
                 (out / f"{name}.json").write_text(json.dumps(asdict(record), indent=2))
                 model.save(out / f"{name}_model.zip")
