@@ -83,7 +83,8 @@ def test_pretraining_runs_from_homing_train_and_records_its_fit(tmp_path):
           "--hp", "pretrain_positions=40"])
     record = json.loads((run / "pretrain.json").read_text())
     assert record["positions"] == 40 and record["samples"][-1] == 2048
-    assert (run / "pretrain_model.zip").is_file() and (run / "model.zip").is_file()
+    for name in ("pretrain_model.zip", "model.zip", "learning_curve.png"):
+        assert (run / name).is_file(), name
 
 
 def test_pretraining_refuses_other_observation_keys():

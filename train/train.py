@@ -181,7 +181,8 @@ def latest_checkpoint(run: Path) -> Path | None:
 
 
 def plot_learning_curve(run: Path) -> Path | None:
-    """``learning_curve.png`` from ``evaluations.npz``: mean return and success rate."""
+    """``learning_curve.png`` from ``evaluations.npz``: mean return and success rate; with
+    a ``pretrain.json``, a first panel of the pretraining's agreement with the oracle."""
     data_path = run / "evaluations.npz"
     if not data_path.is_file():
         return None
@@ -192,7 +193,19 @@ def plot_learning_curve(run: Path) -> Path | None:
 
     data = np.load(data_path)
     steps = data["timesteps"]
-    fig, ax = plt.subplots(figsize=(6, 3.5), constrained_layout=True)
+    pretrained = run / "pretrain.json"
+    panels = 2 if pretrained.is_file() else 1
+    fig, axes = plt.subplots(1, panels, figsize=(6 * panels, 3.5), constrained_layout=True)
+    axes = np.atleast_1d(axes)
+    if pretrained.is_file():
+        record = json.loads(pretrained.read_text())
+        axes[0].plot(record["samples"], 100 * np.asarray(record["agreement"]),
+                     color="tab:purple")
+        axes[0].set_xlabel("pretraining samples (rendered pose pairs)")
+        axes[0].set_ylabel("agreement with the oracle (%)")
+        axes[0].set_ylim(0, 100)
+        axes[0].set_title("pretraining: validation positions")
+    ax = axes[-1]
     ax.plot(steps, data["results"].mean(axis=1), color="tab:blue", marker="o", ms=3)
     ax.set_xlabel("environment steps")
     ax.set_ylabel("mean evaluation return", color="tab:blue")
