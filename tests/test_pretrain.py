@@ -75,7 +75,7 @@ def test_pair_labels_turn_towards_the_oracle_waypoint(env):
 
 def test_pretraining_runs_from_homing_train_and_records_its_fit(tmp_path):
     run = tmp_path / "run"
-    main(["--timesteps", "64", "--out", str(run), "--n-envs", "1", "--vec", "dummy",
+    main(["--timesteps", "128", "--out", str(run), "--n-envs", "1", "--vec", "dummy",
           "--no-progress", "--env-kwargs", json.dumps({**KWARGS, "max_episode_steps": 16}),
           "--hp", "n_steps=64", "--hp", "batch_size=32", "--hp", "n_epochs=1",
           "--hp", "eval_freq=128", "--hp", "eval_episodes=1", "--hp", "checkpoint_freq=128",
