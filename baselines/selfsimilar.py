@@ -62,8 +62,8 @@ What it does (the modes of §4):
 
 Choices where the paper is silent (also in ``docs/selfsimilar.md``):
 
-* *The standing place* "in front of A at a fixed distance" (§4.1): ``standoff`` = 0.8 m
-  out along the panel's normal, facing the panel, which is also the env's success place.
+* *The standing place* "in front of A at a fixed distance" (§4.1): ``standoff`` = 1.0 m
+  out along the panel's normal, facing the panel, inside the env's success region.
   Far away (beyond ``far`` m) the robot approaches along the line of sight; closer it
   aims at a point ``max(standoff, 0.6 d)`` out along the normal (``d`` its distance to
   the panel), a funnel that brings it onto the normal as it closes in.
@@ -244,10 +244,9 @@ class SelfSimilarController(Controller):
         return move
 
     def _choose(self, gray, model, goal: int) -> Move | None:
-        if self._pending is not None and not self._blocked(gray):
+        if self._pending is not None:        # after a turn: nothing to check yet
             move, self._pending = self._pending, None
             return move
-        self._pending = None
         if self._escape:
             return self._escape.pop(0)
         if self._blocked(gray):
@@ -420,7 +419,7 @@ class SelfSimilarController(Controller):
 
     def _scan_again(self, goal: int) -> Move:
         """Stay and scan again (§4.3), unless this landmark was scanned from
-        ``MAX_SCANS_HERE`` times since the robot came: then wander off."""
+        ``MAX_SCANS_HERE`` times since the robot came: then dead reckoning or wander."""
         if self._scans_here < MAX_SCANS_HERE:
             return self._start_scan(goal)
         return self._reckon_or_wander(goal)
