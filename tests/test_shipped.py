@@ -16,10 +16,6 @@ def test_a_policy_is_shipped_with_its_config_and_curve():
         assert shipped.path.with_name(f"{name}_curve.png").is_file(), name
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "the shipped ppo_localhoming homes in 1 of these 10 episodes (20% on held-out training "
-    "seeds): PPO from pixels on 2 CPU cores has not learned LocalHoming-v0 yet; "
-    "see docs/training.md"))
 @pytest.mark.parametrize("name", sorted(SHIPPED))
 def test_shipped_policy_reaches_home_in_half_of_10_episodes(name):
     shipped = SHIPPED[name]
