@@ -146,9 +146,13 @@ def test_ship_copies_the_best_model_with_eval_settings_and_curve(tmp_path):
     assert meta["eval_params"] == {"deterministic": True}
     assert meta["timesteps"] == 1000 and meta["commands"] == ["homing-train --seed 3"]
     assert (shipped / "p_curve.png").read_bytes() == b"png"
-    assert ship_run(run, "q", shipped, final=True, stochastic=True).read_bytes() == b"final"
-    assert yaml.safe_load((shipped / "q.yml").read_text())["eval_params"] == {
-        "deterministic": False}
+    assert ship_run(run, "q", shipped, model="final", stochastic=True).read_bytes() == b"final"
+    meta = yaml.safe_load((shipped / "q.yml").read_text())
+    assert meta["eval_params"] == {"deterministic": False} and meta["model"] == "model.zip"
+    with pytest.raises(ValueError, match="pretrain_model.zip is missing"):
+        ship_run(run, "s", shipped, model="pretrain")
+    with pytest.raises(ValueError, match="unknown model"):
+        ship_run(run, "t", shipped, model="latest")
     (run / "summary.json").unlink()
     with pytest.raises(ValueError, match="summary.json"):
         ship_run(run, "r", shipped)

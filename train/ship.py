@@ -1,9 +1,10 @@
 """Ship a trained run: copy its model into ``train/shipped/`` with its settings and curve.
 
-    python -m train.ship runs/ppo_local --name ppo_local
+    python -m train.ship runs/ppo_local --name ppo_local [--model best|final|pretrain|imitation]
 
-writes ``train/shipped/<name>.zip`` (the run's ``best_model.zip``, chosen by the
-evaluation on held-out training seeds, or ``model.zip`` with ``--final``),
+writes ``train/shipped/<name>.zip`` (by default the run's ``best_model.zip``, chosen by
+the evaluation callback on held-out training seeds; ``--model final|pretrain|imitation``
+ships ``model.zip`` or the network as the warm start left it),
 ``<name>.yml`` (the run's config, command, timesteps and wall time, and the
 ``eval_env_kwargs`` that ``homing-suite`` evaluates it with: the training env kwargs
 without the training ``scene``, so the policy is scored in the env's default scene; and
@@ -23,6 +24,9 @@ import yaml
 from train.suite import POLICY_DIR
 
 MAX_BYTES = 10 * 2**20
+#: ``--model`` choices: the run folder's model files.
+MODELS = {"best": "best_model.zip", "final": "model.zip", "pretrain": "pretrain_model.zip",
+          "imitation": "imitation_model.zip"}
 
 
 class _PlainDumper(yaml.SafeDumper):
@@ -32,17 +36,20 @@ class _PlainDumper(yaml.SafeDumper):
         return True
 
 
-def ship_run(run: Path, name: str, folder: Path = POLICY_DIR, final: bool = False,
-             stochastic: bool = False) -> Path:
-    """Copy run ``run`` into ``folder`` as ``name``; returns the shipped zip's path.
-    ``stochastic``: evaluate it by sampling actions (``eval_params: {deterministic:
-    false}``) instead of taking the distribution's mode."""
-    model = run / ("model.zip" if final else "best_model.zip")
-    for needed in (model, run / "config.yml", run / "summary.json", run / "learning_curve.png"):
+def ship_run(run: Path, name: str, folder: Path = POLICY_DIR, model: str = "best",
+             stochastic: bool = False, why: str | None = None) -> Path:
+    """Copy ``model`` (a key of :data:`MODELS`) of run ``run`` into ``folder`` as ``name``;
+    returns the shipped zip's path. ``stochastic``: evaluate it by sampling actions
+    (``eval_params: {deterministic: false}``) instead of taking the distribution's mode.
+    ``why``: how the model was chosen, recorded in the ``.yml``."""
+    if model not in MODELS:
+        raise ValueError(f"unknown model {model!r}; allowed: {list(MODELS)}")
+    path = run / MODELS[model]
+    for needed in (path, run / "config.yml", run / "summary.json", run / "learning_curve.png"):
         if not needed.is_file():
             raise ValueError(f"{run} is not a finished run folder: {needed.name} is missing")
-    if model.stat().st_size > MAX_BYTES:
-        raise ValueError(f"{model} is {model.stat().st_size / 2**20:.1f} MiB; shipped policies "
+    if path.stat().st_size > MAX_BYTES:
+        raise ValueError(f"{path} is {path.stat().st_size / 2**20:.1f} MiB; shipped policies "
                          f"must stay under {MAX_BYTES / 2**20:.0f} MiB")
     config = yaml.safe_load((run / "config.yml").read_text())
     summary = json.loads((run / "summary.json").read_text())
@@ -51,7 +58,9 @@ def ship_run(run: Path, name: str, folder: Path = POLICY_DIR, final: bool = Fals
         "env_id": config["env_id"],
         "eval_env_kwargs": eval_env_kwargs,
         "eval_params": {"deterministic": not stochastic},
-        "model": "final model" if final else "best model on held-out training seeds",
+        "model": MODELS[model],
+        "chosen": why or ("best evaluation-callback return on held-out training seeds"
+                          if model == "best" else f"the run's {MODELS[model]}"),
         "commands": (run / "command.txt").read_text().splitlines()
         if (run / "command.txt").is_file() else [],
         "timesteps": summary["timesteps"],
@@ -65,7 +74,7 @@ def ship_run(run: Path, name: str, folder: Path = POLICY_DIR, final: bool = Fals
             meta[warm_start] = json.loads(record.read_text())
     folder.mkdir(parents=True, exist_ok=True)
     target = folder / f"{name}.zip"
-    shutil.copyfile(model, target)
+    shutil.copyfile(path, target)
     (folder / f"{name}.yml").write_text(yaml.dump(meta, Dumper=_PlainDumper, sort_keys=False))
     shutil.copyfile(run / "learning_curve.png", folder / f"{name}_curve.png")
     return target
@@ -75,13 +84,15 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m train.ship", description=__doc__.split("\n")[0])
     parser.add_argument("run", type=Path, help="run folder written by homing-train")
     parser.add_argument("--name", required=True, help="name of the shipped policy")
-    parser.add_argument("--final", action="store_true",
-                        help="ship model.zip instead of best_model.zip")
+    parser.add_argument("--model", choices=list(MODELS), default="best",
+                        help="which model of the run to ship (default: best)")
+    parser.add_argument("--why", help="how the model was chosen (recorded in the .yml)")
     parser.add_argument("--stochastic", action="store_true",
                         help="evaluate the shipped policy with sampled actions")
     args = parser.parse_args(argv)
     try:
-        target = ship_run(args.run, args.name, final=args.final, stochastic=args.stochastic)
+        target = ship_run(args.run, args.name, model=args.model, stochastic=args.stochastic,
+                          why=args.why)
     except ValueError as err:
         parser.exit(2, f"ship: error: {err}\n")
     print(f"shipped {target}")
