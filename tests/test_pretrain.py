@@ -101,3 +101,26 @@ def test_pretraining_refuses_other_observation_keys():
         pretrain(model, "homing_gym/LocalHoming-v0",
                  {**KWARGS, "obs_keys": ("panorama", "goal", "odometry")}, 8, 1, 16, 0)
     env.close()
+
+
+def test_init_policy_starts_a_run_from_saved_weights(tmp_path):
+    import torch
+    from stable_baselines3 import PPO
+
+    from train.extractor import policy_kwargs_for
+    from train.train import load_policy_weights
+
+    env = gym.make("homing_gym/LocalHoming-v0", **KWARGS)
+    make = lambda seed, dim: PPO("MultiInputPolicy", env, n_steps=16, batch_size=16,  # noqa: E731
+                                 seed=seed, policy_kwargs=policy_kwargs_for("panorama",
+                                                                            features_dim=dim))
+    source, target = make(0, 16), make(1, 16)
+    source.save(tmp_path / "source.zip")
+    load_policy_weights(target, tmp_path / "source.zip")
+    for key, value in source.policy.state_dict().items():
+        assert torch.equal(value, target.policy.state_dict()[key]), key
+    with pytest.raises(ValueError, match="does not fit"):
+        load_policy_weights(make(2, 8), tmp_path / "source.zip")
+    env.close()
+    with pytest.raises(SystemExit):
+        main(["--hp", f"init_policy={tmp_path / 'missing.zip'}", "--no-progress"])

@@ -70,6 +70,7 @@ class TrainConfig:
     pretrain_positions: int = 4000
     pretrain_scenes: int = 1
     warm_start_learning_rate: float = 3e-4
+    init_policy: str | None = None
     ppo: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -92,6 +93,9 @@ class TrainConfig:
         rate = self.warm_start_learning_rate
         if not (isinstance(rate, (int, float)) and math.isfinite(rate) and rate > 0):
             raise ValueError(f"warm_start_learning_rate must be a positive number, got {rate!r}")
+        if self.init_policy is not None and not Path(self.init_policy).is_file():
+            raise ValueError(f"init_policy {self.init_policy!r} is not a file (give a saved "
+                             f"stable-baselines3 PPO .zip)")
         if not isinstance(self.eval_deterministic, bool):
             raise ValueError(f"eval_deterministic must be true or false, got "
                              f"{self.eval_deterministic!r}")
@@ -236,6 +240,19 @@ def _restore_evaluations(callback, run: Path) -> None:
         callback.best_mean_reward = float(np.max(np.mean(data["results"], axis=1)))
 
 
+def load_policy_weights(model, path: str | Path) -> None:
+    """Copy the policy network (extractor, actor and critic) of the PPO model saved at
+    ``path`` into ``model``; the two networks must have the same layout."""
+    from stable_baselines3 import PPO
+
+    source = PPO.load(path, device=model.device)
+    try:
+        model.policy.load_state_dict(source.policy.state_dict())
+    except RuntimeError as err:
+        raise ValueError(f"init_policy {str(path)!r} does not fit this run's network (same "
+                         f"env kwargs, extractor and features_dim needed): {err}") from err
+
+
 def warm_starts(config: TrainConfig, progress: bool = True) -> list[tuple[str, Any]]:
     """The warm starts the run asks for, in order, as ``(name, fit)`` with ``fit(model)``
     returning a dataclass record: behaviour cloning on rendered pose pairs
@@ -288,6 +305,8 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
                                                            if config.extractor == "panorama"
                                                            else {})),
                         **config.ppo)
+            if config.init_policy:
+                load_policy_weights(model, config.init_policy)
             for name, warm_start in warm_starts(config, progress):
                 # the warm starts' own step size; PPO sets its schedule's again in train()
                 for group in model.policy.optimizer.param_groups:
