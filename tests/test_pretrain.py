@@ -124,3 +124,25 @@ def test_init_policy_starts_a_run_from_saved_weights(tmp_path):
     env.close()
     with pytest.raises(SystemExit):
         main(["--hp", f"init_policy={tmp_path / 'missing.zip'}", "--no-progress"])
+
+
+def test_critic_warmup_leaves_the_actor_unchanged(tmp_path):
+    """A run whose steps are all critic warm-up changes the value layers only."""
+    import torch
+    from stable_baselines3 import PPO
+
+    run = tmp_path / "run"
+    args = ["--timesteps", "64", "--n-envs", "1", "--vec", "dummy", "--no-progress",
+            "--env-kwargs", json.dumps({**KWARGS, "max_episode_steps": 16}),
+            "--hp", "n_steps=32", "--hp", "batch_size=16", "--hp", "n_epochs=2",
+            "--hp", "eval_freq=1000", "--hp", "checkpoint_freq=1000", "--hp", "features_dim=16",
+            "--hp", "learning_rate=0.01"]
+    main([*args, "--out", str(tmp_path / "source")])
+    main([*args, "--out", str(run), "--hp", f"init_policy={tmp_path / 'source' / 'model.zip'}",
+          "--hp", "critic_warmup_steps=64"])
+    before = PPO.load(tmp_path / "source" / "model.zip").policy.state_dict()
+    after = PPO.load(run / "model.zip").policy.state_dict()
+    critic = [k for k in before if k.startswith(("value_net", "mlp_extractor.value_net"))]
+    assert critic and any(not torch.equal(before[k], after[k]) for k in critic)
+    for key in set(before) - set(critic):
+        assert torch.equal(before[key], after[key]), key

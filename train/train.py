@@ -71,6 +71,7 @@ class TrainConfig:
     pretrain_scenes: int = 1
     warm_start_learning_rate: float = 3e-4
     init_policy: str | None = None
+    critic_warmup_steps: int = 0
     ppo: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -86,7 +87,7 @@ class TrainConfig:
             value = getattr(self, key)
             if not (isinstance(value, int) and value >= 1):
                 raise ValueError(f"{key} must be an integer >= 1, got {value!r}")
-        for key in ("imitation_iterations", "pretrain_samples"):
+        for key in ("imitation_iterations", "pretrain_samples", "critic_warmup_steps"):
             value = getattr(self, key)
             if not (isinstance(value, int) and value >= 0):
                 raise ValueError(f"{key} must be an integer >= 0, got {value!r}")
@@ -240,6 +241,19 @@ def _restore_evaluations(callback, run: Path) -> None:
         callback.best_mean_reward = float(np.max(np.mean(data["results"], axis=1)))
 
 
+def set_actor_trainable(policy, trainable: bool) -> None:
+    """Freeze (``trainable=False``) or release every parameter of an SB3 actor-critic
+    policy except the critic's own layers (value MLP and head, and its features extractor
+    when not shared): PPO updates then fit the value function alone."""
+    critic = [policy.mlp_extractor.value_net, policy.value_net]
+    if not policy.share_features_extractor:
+        critic.append(policy.vf_features_extractor)
+    critic_ids = {id(p) for module in critic for p in module.parameters()}
+    for parameter in policy.parameters():
+        if id(parameter) not in critic_ids:
+            parameter.requires_grad_(trainable)
+
+
 def load_policy_weights(model, path: str | Path) -> None:
     """Copy the policy network (extractor, actor and critic) of the PPO model saved at
     ``path`` into ``model``; the two networks must have the same layout."""
@@ -325,9 +339,18 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
         ckpt_cb = CheckpointCallback(max(config.checkpoint_freq // config.n_envs, 1),
                                      str(out / "checkpoints"), name_prefix="ppo")
         t0 = time.perf_counter()
-        if remaining > 0:
-            model.learn(remaining, callback=[eval_cb, ckpt_cb], progress_bar=progress,
-                        reset_num_timesteps=checkpoint is None, tb_log_name="ppo")
+        # the first critic_warmup_steps fit the value function only (actor frozen), so that
+        # a warm-started actor is not updated with a random critic's advantages
+        warmup = min(max(config.critic_warmup_steps - start_steps, 0), max(remaining, 0))
+        fresh = checkpoint is None
+        for steps, critic_only in ((warmup, True), (remaining - warmup, False)):
+            if steps <= 0:
+                continue
+            set_actor_trainable(model.policy, not critic_only)
+            model.learn(steps, callback=[eval_cb, ckpt_cb], progress_bar=progress,
+                        reset_num_timesteps=fresh, tb_log_name="ppo")
+            fresh = False
+        set_actor_trainable(model.policy, True)
         wall = time.perf_counter() - t0
         model.save(out / "model.zip")
         summary_path = out / "summary.json"
