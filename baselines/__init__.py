@@ -1,10 +1,10 @@
 """Scripted visual-homing controllers behind one interface, and their registry.
 
 >>> import baselines
->>> baselines.available()
+>>> homing_baselines.available()
 ['bearing', 'bearing-basic', 'bearing-complementary', 'bearing-longrange', 'distance',
  'multires', 'oracle', 'random', 'selfsimilar', 'snapshot', 'warping']
->>> controller = baselines.make("oracle", step_length=0.2)
+>>> controller = homing_baselines.make("oracle", step_length=0.2)
 """
 
 from __future__ import annotations
@@ -12,24 +12,24 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-from baselines.base import Controller
-from baselines.motion import MotionHelper, MotionSpec, Move
-from baselines.bearing import (BasicBearingController, BearingController,
+from homing_baselines.base import Controller
+from homing_baselines.motion import MotionHelper, MotionSpec, Move
+from homing_baselines.bearing import (BasicBearingController, BearingController,
                                ComplementaryBearingController)
-from baselines.bearing_longrange import LongRangeBearingController
-from baselines.distance import DistanceController
-from baselines.multires import MultiResController
-from baselines.oracle import OracleController
-from baselines.random_walk import RandomController
-from baselines.selfsimilar import SelfSimilarController
-from baselines.snapshot import SnapshotController
-from baselines.warping import WarpingController
+from homing_baselines.bearing_longrange import LongRangeBearingController
+from homing_baselines.distance import DistanceController
+from homing_baselines.multires import MultiResController
+from homing_baselines.oracle import OracleController
+from homing_baselines.random_walk import RandomController
+from homing_baselines.selfsimilar import SelfSimilarController
+from homing_baselines.snapshot import SnapshotController
+from homing_baselines.warping import WarpingController
 
 _REGISTRY: dict[str, type[Controller]] = {}
 
 
 def register(name: str, cls: type[Controller]) -> None:
-    """Make controller class ``cls`` available as ``baselines.make(name)``."""
+    """Make controller class ``cls`` available as ``homing_baselines.make(name)``."""
     if not (isinstance(cls, type) and issubclass(cls, Controller)):
         raise TypeError(f"{cls!r} is not a Controller subclass")
     cls.name = name

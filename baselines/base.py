@@ -6,9 +6,9 @@ defaults). The harness drives it exactly like a stable-baselines3 model::
     action, state = controller.predict(observation, state=None, episode_start=True)
 
 Subclasses implement :meth:`Controller.decide`: from the current observation, return the
-next :class:`~baselines.motion.Move` (home vector: direction in the robot frame and step
+next :class:`~homing_baselines.motion.Move` (home vector: direction in the robot frame and step
 length) or ``None`` to stop (arrived). The base class executes each move over several env
-steps with the shared :class:`~baselines.motion.MotionHelper`, asks for the next decision
+steps with the shared :class:`~homing_baselines.motion.MotionHelper`, asks for the next decision
 once the move is done, and records the commanded direction in :attr:`last_direction` and
 the controller's latest home-direction estimate in :attr:`last_home_direction` (robot
 frame at the time of the decision; used by the homing vector field).
@@ -26,19 +26,19 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from baselines.motion import MOTION_STYLES, MotionHelper, MotionSpec, Move
+from homing_baselines.motion import MOTION_STYLES, MotionHelper, MotionSpec, Move
 
 
 @dataclasses.dataclass
 class Controller(ABC):
     """Base class of scripted controllers. Fields common to all of them:
 
-    ``motion``: ``"turn_then_drive"`` or ``"pursuit"`` (see :mod:`baselines.motion`).
+    ``motion``: ``"turn_then_drive"`` or ``"pursuit"`` (see :mod:`homing_baselines.motion`).
     """
 
     motion: str = "turn_then_drive"
 
-    #: Registry name (set by :func:`baselines.register`).
+    #: Registry name (set by :func:`homing_baselines.register`).
     name: ClassVar[str] = ""
     #: True only for oracle controllers: the harness then calls :meth:`attach_env`.
     needs_env: ClassVar[bool] = False

@@ -4,11 +4,11 @@ bearing-only homing laws (§2) driven by coloured-blob landmarks seen in the pan
 Every decision (:meth:`BearingController.decide`):
 
 1. finds the coloured landmarks in the current panorama and in the goal panorama
-   (:func:`baselines.blobs.detect_blobs`, §4 "Centroids of colored blobs"; identity by
+   (:func:`homing_baselines.blobs.detect_blobs`, §4 "Centroids of colored blobs"; identity by
    colour) and keeps those seen in both, in the order of ``colors``;
 2. stops (returns ``None``, the env's stop action) when the two snapshots are similar:
    every angular separation agrees within ``stop_tol`` radians
-   (:func:`baselines.bearing_laws.snapshots_similar`, Algorithm 1's "until current
+   (:func:`homing_baselines.bearing_laws.snapshots_similar`, Algorithm 1's "until current
    snapshot A and goal snapshot T are similar");
 3. otherwise evaluates the law on the bearings (the basic law Eq. 1-2, the
    complementary law, or the unified law of Algorithm 1, whose state persists through
@@ -48,11 +48,11 @@ from typing import ClassVar
 
 import numpy as np
 
-from baselines.base import Controller
-from baselines.bearing_laws import (LAWS, LawResult, UnifiedConfig, UnifiedLaw, basic_law,
+from homing_baselines.base import Controller
+from homing_baselines.bearing_laws import (LAWS, LawResult, UnifiedConfig, UnifiedLaw, basic_law,
                                     complementary_law, snapshots_similar)
-from baselines.blobs import LAB_COLORS, BlobColor, detect_blobs, matched_bearings
-from baselines.motion import Move
+from homing_baselines.blobs import LAB_COLORS, BlobColor, detect_blobs, matched_bearings
+from homing_baselines.motion import Move
 
 #: Landmark colours a controller may use, by name.
 PALETTE: dict[str, BlobColor] = {c.name: c for c in LAB_COLORS}

@@ -2,7 +2,7 @@
 KLT corner features (§4), for ``homing_gym/LongRangeHoming-v0``.
 
 **Visual memory** (outbound, ``observation["phase"] == 0``; the env drives and ignores the
-actions): every frame goes through the KLT tracker (:class:`baselines.klt.CornerTracker`)
+actions): every frame goes through the KLT tracker (:class:`homing_baselines.klt.CornerTracker`)
 and the controller stores, per frame, the ids and positions of the live tracks and the
 prepared image. A track never comes back once lost, so a feature's *life cycle* (a line
 of Fig. 5) is the run of frames from its birth to its last sighting.
@@ -18,19 +18,19 @@ from that MP, until home (frame 0) is an MP. If not even the previous frame shar
 **Homing**, leg by leg: the target snapshot of a leg is the memory's bearings, at the MP,
 of the features it shares with the leg's start; the current snapshot is the live tracks
 of those features; the unified law (Algorithm 1) gives the motion vector, executed as in
-:class:`baselines.bearing.BearingLawController` (the step scales with ``|M|`` per pair, so
+:class:`homing_baselines.bearing.BearingLawController` (the step scales with ``|M|`` per pair, so
 it shrinks near the MP with 80 features as with three).
 
 **Arrival and realignment** (§3): at an MP ``P`` the robot stands at ``P'``, the same
 place under another heading, so every bearing differs by one constant,
 ``A_P(F_i) - A_P'(F_i) = phi``, estimated as the median offset. The robot has arrived when
 at least ``inlier_fraction`` of the leg's live features lie within ``stop_tol`` of
-``phi``: Algorithm 1's "snapshots similar" (:func:`baselines.bearing_laws.snapshots_similar`
+``phi``: Algorithm 1's "snapshots similar" (:func:`homing_baselines.bearing_laws.snapshots_similar`
 with ``aligned=True`` after rotating by ``phi``), made robust to the KLT tracks that drift
 onto another corner over a long leg (one would stop the plain test from ever holding). It
 then predicts where every feature of the MP's memory frame lies now (shifted by ``phi``)
 and re-attaches them by LK from the stored image, starting at the prediction
-(:meth:`baselines.klt.CornerTracker.register`: the paper's "feature selection ... in
+(:meth:`homing_baselines.klt.CornerTracker.register`: the paper's "feature selection ... in
 small windows centred at the predicted locations"), and starts the next leg. At home it
 turns by ``-phi`` to the home heading and stops.
 
@@ -47,7 +47,7 @@ Choices where the paper is open (also in ``docs/bearing.md``):
   every step, so its state restarts whenever the set changes. With corners all around,
   criterion 1 (goal inside their hull) decides BASIC at once, so little is lost.
 * With fewer than three live features of a leg the robot makes the search move of
-  :class:`~baselines.bearing.BearingLawController`.
+  :class:`~homing_baselines.bearing.BearingLawController`.
 
 The controller reads ``panorama`` and ``phase`` only (not ``goal``: the home snapshot is
 its first memory frame).
@@ -61,10 +61,10 @@ from typing import ClassVar, Sequence
 
 import numpy as np
 
-from baselines.bearing import BearingLawController
-from baselines.bearing_laws import UnifiedLaw
-from baselines.klt import CornerTracker, KLTConfig
-from baselines.motion import Move
+from homing_baselines.bearing import BearingLawController
+from homing_baselines.bearing_laws import UnifiedLaw
+from homing_baselines.klt import CornerTracker, KLTConfig
+from homing_baselines.motion import Move
 from homing_gym.geometry import wrap_angle
 from homing_gym.panorama import column_bearing
 
@@ -122,8 +122,8 @@ class LongRangeBearingController(BearingLawController):
     """Long-range homing (module docstring). Parameters: ``min_shared`` (features that
     consecutive milestones share, 3 to ``klt.max_features``), ``inlier_fraction`` (of a
     leg's live features that must agree with ``phi`` to arrive), ``klt``
-    (:class:`~baselines.klt.KLTConfig`) and those of
-    :class:`~baselines.bearing.BearingLawController` (``stop_tol``: the arrival tolerance
+    (:class:`~homing_baselines.klt.KLTConfig`) and those of
+    :class:`~homing_baselines.bearing.BearingLawController` (``stop_tol``: the arrival tolerance
     on each feature's offset from ``phi``, radians)."""
 
     min_shared: int = 80

@@ -1,11 +1,11 @@
-"""Pure 2-D simulator of the bearing-only laws of :mod:`baselines.bearing_laws` (the
+"""Pure 2-D simulator of the bearing-only laws of :mod:`homing_baselines.bearing_laws` (the
 simulator of Bekris, Argyros & Kavraki §5 "Verifying the local control laws", used for
 their Fig. 4 and Fig. 8).
 
 Landmarks are points on the plane, the robot a point (§2: "the robot is abstracted as a
 point on the 2D plane") that measures ideal bearings (``atan2``, world frame, radians
 CCW) and moves a fixed ``step`` (metres) along the unit motion vector until the stop test
-(:func:`~baselines.bearing_laws.snapshots_similar`) holds or ``max_steps`` have passed.
+(:func:`~homing_baselines.bearing_laws.snapshots_similar`) holds or ``max_steps`` have passed.
 A run succeeds when it ends within ``success_radius`` of the goal.
 
 Everything is batched over robots so that a reachability map (one run per grid point)
@@ -21,7 +21,7 @@ from typing import Callable, Literal
 
 import numpy as np
 
-from baselines.bearing_laws import (DEFAULT_STOP_TOL, LAWS, UnifiedBatch, UnifiedConfig,
+from homing_baselines.bearing_laws import (DEFAULT_STOP_TOL, LAWS, UnifiedBatch, UnifiedConfig,
                                     motion_vectors, snapshots_similar)
 
 

@@ -56,9 +56,9 @@ from typing import ClassVar, Sequence
 
 import numpy as np
 
-from baselines.base import Controller
-from baselines.landmarks_red import Arc, RedSegmentation, detect_landmarks
-from baselines.motion import Move, integrate
+from homing_baselines.base import Controller
+from homing_baselines.landmarks_red import Arc, RedSegmentation, detect_landmarks
+from homing_baselines.motion import Move, integrate
 from homing_gym.geometry import wrap_angle
 
 ASSIGNMENT_MODES = ("cyclic", "all")

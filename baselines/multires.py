@@ -6,17 +6,17 @@ taught on the teaching day, keys of ``WorkLocations-v0``):
 
 1. **Travel** (§3(1)): the current panorama is reduced to the taught low resolution
    and its front (``front_fov_deg`` wide) correlated with every panorama of the path
-   (:func:`~baselines.multires_matching.locate_on_path`); the best is the current place,
+   (:func:`~homing_baselines.multires_matching.locate_on_path`); the best is the current place,
    its offset the deviation from the desired direction of travel. The robot turns by
    minus the deviation and drives ``step_length`` (the paper's dolly was pushed "while
    the traveling direction is continuously adjusted to maintain a zero deviation").
 2. **Arrival decision** (§3(1), Fig. 5): once the best place is the path's last (the
    target work location), the front image is enlarged or reduced through ``scales`` and
-   compared with the target's panorama (:func:`~baselines.multires_matching.arrival_scores`):
+   compared with the target's panorama (:func:`~homing_baselines.multires_matching.arrival_scores`):
    enlarged best, not yet there: forward ``arrival_step``; reduced best, past it:
    backward; unscaled best: approximately at the work location.
 3. **Work location** (§3(2)): self-localisation with the multiresolution feature image
-   map (:func:`~baselines.multires_localise.localise`); the robot drives to the taught
+   map (:func:`~homing_baselines.multires_localise.localise`); the robot drives to the taught
    position while it is more than ``stop_tolerance`` away (problem (a): "errors must be
    visually detected so the robot can reach the specified location with sufficient
    accuracy"), turns to the taught heading, and stops. If fewer than two
@@ -34,10 +34,10 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from baselines.base import Controller
-from baselines.motion import MotionSpec, Move
-from baselines.multires_localise import LocaliseConfig, localise
-from baselines.multires_matching import arrival_scores, front_view, locate_on_path
+from homing_baselines.base import Controller
+from homing_baselines.motion import MotionSpec, Move
+from homing_baselines.multires_localise import LocaliseConfig, localise
+from homing_baselines.multires_matching import arrival_scores, front_view, locate_on_path
 from homing_gym.geometry import to_frame
 from homing_gym.tasks.work_locations import TAUGHT_KEYS
 from homing_gym.teaching import FeatureMap, grey, low_resolution

@@ -11,7 +11,7 @@
       (b-2), from being confused);
 
 then, with two or more rediscovered points, compute position and heading from their
-known 3-D coordinates and apparent directions (:func:`~baselines.multires_matching.triangulate`).
+known 3-D coordinates and apparent directions (:func:`~homing_baselines.multires_matching.triangulate`).
 
 Choices where the paper is silent: the apparent direction of a point is its bearing
 *and* its elevation (with the camera height known, two points then fix the pose); the
@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from baselines.multires_matching import (find_template, front_view, match_heading,
+from homing_baselines.multires_matching import (find_template, front_view, match_heading,
                                          predicted_directions, triangulate)
 from homing_gym.geometry import wrap_angle
 from homing_gym.panorama import bearing_column, column_bearing, row_elevation

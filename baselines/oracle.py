@@ -15,8 +15,8 @@ import math
 from dataclasses import dataclass
 from typing import ClassVar
 
-from baselines.base import Controller
-from baselines.motion import Move
+from homing_baselines.base import Controller
+from homing_baselines.motion import Move
 from homing_gym.paths import NoPathError, segment_free, shortest_path
 from homing_gym.geometry import bearing_to, wrap_angle
 from homing_gym.scenes.base import clearance

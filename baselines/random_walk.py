@@ -7,8 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from baselines.base import Controller
-from baselines.motion import Move
+from homing_baselines.base import Controller
+from homing_baselines.motion import Move
 
 
 @dataclass

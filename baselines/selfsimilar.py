@@ -2,12 +2,12 @@
 (Briggs, Scharstein et al. 2000, §4).
 
 The robot knows the landmark design, not the map. Each episode it starts with an empty
-:class:`~baselines.selfsimilar_graph.VisibilityGraph` and a global frame of its own:
+:class:`~homing_baselines.selfsimilar_graph.VisibilityGraph` and a global frame of its own:
 where it was switched on, heading 0 (§4.1). It reads only the observation:
 
 * ``view``: the forward perspective camera (the paper's camera; the default panorama is
   far too coarse for the detector, see ``docs/selfsimilar.md``), searched by
-  :func:`~baselines.selfsimilar_detector.detect_landmarks` at every decision;
+  :func:`~homing_baselines.selfsimilar_detector.detect_landmarks` at every decision;
 * ``goal_id``: the one-hot goal landmark;
 * ``odometry``: wheel odometry. Only its *increments* between decisions are used (dead
   reckoning of the robot's own pose and the travelled distance of §4.1); its absolute
@@ -45,7 +45,7 @@ What it does (the modes of §4):
    the way, hop by hop as in navigation; if every landmark of the graph was scanned
    from, dead-reckon to the closest one known that was not.
 4. **Visual servoing** to a landmark: detect it in every view, measure the panel's
-   centre and normal (:func:`~baselines.selfsimilar_panel.panel_pose`) and step
+   centre and normal (:func:`~homing_baselines.selfsimilar_panel.panel_pose`) and step
    towards its standing place ``standoff`` m out along the normal, facing it; the
    edge driven is annotated with the distance travelled (§4.1). A landmark out of view
    is turned to (its last position by dead reckoning); one not found where it should be
@@ -92,12 +92,12 @@ from typing import ClassVar
 import networkx as nx
 import numpy as np
 
-from baselines.base import Controller
-from baselines.camera_models import PerspectiveModel
-from baselines.motion import Move
-from baselines.selfsimilar_detector import Detection, DetectorConfig, detect_landmarks, to_gray
-from baselines.selfsimilar_graph import VisibilityGraph
-from baselines.selfsimilar_panel import panel_pose
+from homing_baselines.base import Controller
+from homing_baselines.camera_models import PerspectiveModel
+from homing_baselines.motion import Move
+from homing_baselines.selfsimilar_detector import Detection, DetectorConfig, detect_landmarks, to_gray
+from homing_baselines.selfsimilar_graph import VisibilityGraph
+from homing_baselines.selfsimilar_panel import panel_pose
 from homing_gym.geometry import wrap_angle
 
 PLANNING = ("deterministic", "probabilistic")

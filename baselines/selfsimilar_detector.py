@@ -36,7 +36,7 @@ neighbours only where it matched) and ``peak_step = l`` (``m_y`` only at every
 
 The result gives each landmark's id, image position, bearing, apparent size and the
 horizontal distance from its apparent height (§4.1) through a camera model
-(:mod:`baselines.camera_models`), so it runs on perspective images and on the
+(:mod:`homing_baselines.camera_models`), so it runs on perspective images and on the
 panorama alike (columns wrap around in a panorama).
 """
 
@@ -47,7 +47,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from baselines.camera_models import CameraModel
+from homing_baselines.camera_models import CameraModel
 from homing_gym.geometry import wrap_angle
 from homing_gym.panorama import LUMA
 from homing_gym.selfsimilar import (BARCODE_BANDS, DEFAULT_P, PanelLayout, check_p,
@@ -114,7 +114,7 @@ class DetectorConfig:
 @dataclass(frozen=True)
 class Detection:
     """One landmark found in an image (pixel-index coordinates; see
-    :mod:`baselines.camera_models`).
+    :mod:`homing_baselines.camera_models`).
 
     ``x``, ``y``: the pattern's self-similarity origin (its left edge) on the middle row
     of the extent; ``top``, ``bottom``: rows of the pattern's edges on that line;

@@ -30,8 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from baselines.camera_models import CameraModel
-from baselines.selfsimilar_detector import Detection
+from homing_baselines.camera_models import CameraModel
+from homing_baselines.selfsimilar_detector import Detection
 from homing_gym.selfsimilar import PanelLayout
 
 #: Accepted ratio of the measured to the known distance between the two columns.

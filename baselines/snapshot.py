@@ -2,7 +2,7 @@
 
 Pipeline of :func:`hong_homing` (current view, target view) -> :class:`HomingEstimate`:
 
-1. §2: both views become 360-sample location signatures (:mod:`baselines.signature`); up
+1. §2: both views become 360-sample location signatures (:mod:`homing_baselines.signature`); up
    to 15 characteristic points are picked in the *current* signature ``V``.
 2. §3: each point's 13-sample window is matched against windows of the target signature
    ``V^T`` with the reshaped, deviation-corrected, L1-normalised difference
@@ -47,9 +47,9 @@ from typing import Any
 
 import numpy as np
 
-from baselines.base import Controller
-from baselines.motion import Move, integrate
-from baselines.signature import (CharacteristicPoints, characteristic_points,
+from homing_baselines.base import Controller
+from homing_baselines.motion import Move, integrate
+from homing_baselines.signature import (CharacteristicPoints, characteristic_points,
                                  signature_from_omni, signature_from_panorama)
 from homing_gym.geometry import wrap_angle
 from homing_gym.tasks.route_following import FOOT

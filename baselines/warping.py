@@ -39,8 +39,8 @@ from functools import lru_cache
 import cv2
 import numpy as np
 
-from baselines.base import Controller
-from baselines.motion import Move
+from homing_baselines.base import Controller
+from homing_baselines.motion import Move
 from homing_gym.geometry import wrap_angle
 from homing_gym.panorama import LUMA, bearing_column, column_bearing, signature_weights
 

@@ -145,7 +145,7 @@ class HomingEnv(gym.Env):
     def skip_next_images(self) -> None:
         """Harness hint for one step: the agent will not read the next observation (a
         scripted controller in the middle of a move, see
-        :meth:`baselines.base.Controller.needs_next_observation`), so the next
+        :meth:`homing_baselines.base.Controller.needs_next_observation`), so the next
         :meth:`step` renders no camera image and returns the previous observation with
         fresh ``odometry``. Episodes, rewards and info are unchanged."""
         self._skip_images = True

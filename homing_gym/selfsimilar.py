@@ -17,7 +17,7 @@ choices (:class:`PanelLayout`), left to right on a white panel with a white marg
   self-similarity origin ``u = 0`` (infinitely fine stripes, grey once rendered) at its
   left edge, the coarsest stripe (dark, ``u`` in ``(sqrt(p), 1)``) at its right edge;
 * a white gap of ``gap`` metres, much narrower than the coarsest stripe, so that a
-  detector can tell where the pattern ends (:mod:`baselines.selfsimilar_detector`);
+  detector can tell where the pattern ends (:mod:`homing_baselines.selfsimilar_detector`);
 * the barcode, a column ``barcode_width`` metres wide of ``BARCODE_BANDS`` horizontal
   bands of equal height, top to bottom: a dark guard band, ``ID_BITS`` identity bits
   (most significant first, dark = 1), an even-parity bit and a dark guard band. The

@@ -6,25 +6,25 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-import baselines
-from baselines.motion import MotionHelper, MotionSpec, Move, integrate
-from train.evaluate import prepare_policy, run_episode
-from train.policies import parse_params
+import homing_baselines
+from homing_baselines.motion import MotionHelper, MotionSpec, Move, integrate
+from homing_train.harness.evaluate import prepare_policy, run_episode
+from homing_train.harness.policies import parse_params
 
 ENV_ID = "homing_gym/LocalHoming-v0"
 
 
 def test_registry_lists_and_makes_controllers():
-    assert {"oracle", "random"} <= set(baselines.available())
-    c = baselines.make("oracle", step_length=0.2)
+    assert {"oracle", "random"} <= set(homing_baselines.available())
+    c = homing_baselines.make("oracle", step_length=0.2)
     assert c.step_length == 0.2 and c.needs_env
-    assert not baselines.make("random").needs_env
+    assert not homing_baselines.make("random").needs_env
     with pytest.raises(ValueError, match="available"):
-        baselines.make("nope")
+        homing_baselines.make("nope")
     with pytest.raises(ValueError, match="no parameter"):
-        baselines.make("random", speed=3)
+        homing_baselines.make("random", speed=3)
     with pytest.raises(ValueError, match="step_length"):
-        baselines.make("random", step_length=-1.0)
+        homing_baselines.make("random", step_length=-1.0)
 
 
 def test_parse_params_types_and_errors():
@@ -68,12 +68,12 @@ def test_bad_moves_and_styles_raise():
     with pytest.raises(ValueError):
         Move(math.nan, 1.0)
     with pytest.raises(ValueError, match="motion"):
-        baselines.make("random", motion="teleport")
+        homing_baselines.make("random", motion="teleport")
 
 
 def test_random_controller_is_reproducible_per_episode_seed():
     def directions(seed):
-        c = baselines.make("random")
+        c = homing_baselines.make("random")
         c.reset(seed)
         out = []
         for _ in range(40):
@@ -87,14 +87,14 @@ def test_random_controller_is_reproducible_per_episode_seed():
 
 def test_non_oracle_refuses_the_env():
     with pytest.raises(TypeError, match="observations only"):
-        baselines.make("random").attach_env(object())
+        homing_baselines.make("random").attach_env(object())
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_oracle_reaches_home_and_stops_there(seed):
     env = gym.make(ENV_ID, success_on="stop", max_episode_steps=300)
     try:
-        oracle = baselines.make("oracle")
+        oracle = homing_baselines.make("oracle")
         prepare_policy(oracle, env)
         record = run_episode(env, oracle, seed)
     finally:
@@ -108,7 +108,7 @@ def test_oracle_reaches_home_and_stops_there(seed):
 def test_oracle_discrete_actions_reach_home():
     env = gym.make(ENV_ID, action_type="discrete", max_episode_steps=300)
     try:
-        oracle = baselines.make("oracle")
+        oracle = homing_baselines.make("oracle")
         prepare_policy(oracle, env)
         record = run_episode(env, oracle, 4)
     finally:

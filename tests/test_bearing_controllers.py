@@ -5,13 +5,13 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-import baselines
-from baselines.bearing_sim import region
+import homing_baselines
+from homing_baselines.bearing_sim import region
 from homing_gym.envs import LocalHomingEnv
 from homing_gym.scenes import available_scenes, scene_factory
 from homing_gym.scenes.base import clearance
 from homing_gym.simulator import Simulator
-from train.evaluate import evaluate, prepare_policy, run_episode
+from homing_train.harness.evaluate import evaluate, prepare_policy, run_episode
 
 ENV_ID = "homing_gym/LocalHoming-v0"
 #: The region each marked position must lie in (Fig. 9b).
@@ -39,7 +39,7 @@ def lab():
 
 
 def _run(env, name, start, goal, **params):
-    controller = baselines.make(name, **params)
+    controller = homing_baselines.make(name, **params)
     prepare_policy(controller, env)
     marked = env.unwrapped.scene.metadata["marked"]
     return run_episode(env, controller, 0, start=start, home=(*marked[goal], 0.5)), controller
@@ -71,7 +71,7 @@ def test_bearing_controllers_run_in_the_harness_from_the_observation_only():
                       env_kwargs={"scene": "lab", "max_episode_steps": 30})
     assert result.env_kwargs["obs_keys"] == ["panorama", "goal"]
     assert len(result.episodes) == 2
-    controller = baselines.make("bearing")
+    controller = homing_baselines.make("bearing")
     forbidden = (gym.Env, Simulator, LocalHomingEnv)
     env = gym.make(ENV_ID, scene="lab", max_episode_steps=20)
     try:
@@ -95,4 +95,4 @@ def test_bearing_controllers_run_in_the_harness_from_the_observation_only():
 def test_bad_controller_parameters_raise(params, match):
     for name in ("bearing", "bearing-basic", "bearing-complementary"):
         with pytest.raises(ValueError, match=match):
-            baselines.make(name, **params)
+            homing_baselines.make(name, **params)

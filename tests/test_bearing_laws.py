@@ -1,16 +1,16 @@
-"""Bearing-only homing laws of Bekris, Argyros & Kavraki (baselines.bearing_laws) and
-their pure 2-D simulator (baselines.bearing_sim)."""
+"""Bearing-only homing laws of Bekris, Argyros & Kavraki (homing_baselines.bearing_laws) and
+their pure 2-D simulator (homing_baselines.bearing_sim)."""
 
 import math
 
 import numpy as np
 import pytest
 
-from baselines.bearing_laws import (Criterion, UnifiedConfig, UnifiedLaw, UnifiedState,
+from homing_baselines.bearing_laws import (Criterion, UnifiedConfig, UnifiedLaw, UnifiedState,
                                     angular_separations, basic_law, complementary_law,
                                     cyclic_order, eq1_gain, inside_triangle, landmark_pairs,
                                     motion_vectors, nearest_landmark_pair, snapshots_similar)
-from baselines.bearing_sim import (SimConfig, bearings, circumcircle, reachability_map, region,
+from homing_baselines.bearing_sim import (SimConfig, bearings, circumcircle, reachability_map, region,
                                    simulate, simulate_batch)
 
 PI = math.pi

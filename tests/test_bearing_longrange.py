@@ -8,10 +8,10 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-import baselines
-from baselines.bearing_longrange import birth_frames, choose_milestones, median_offset
-from baselines.klt import KLTConfig
-from train.evaluate import prepare_policy, run_episode
+import homing_baselines
+from homing_baselines.bearing_longrange import birth_frames, choose_milestones, median_offset
+from homing_baselines.klt import KLTConfig
+from homing_train.harness.evaluate import prepare_policy, run_episode
 
 
 def test_milestones_are_the_earliest_frames_sharing_enough_features():
@@ -45,7 +45,7 @@ def test_longrange_homes_from_pixels_and_turns_to_the_home_heading():
     env = gym.make("homing_gym/LongRangeHoming-v0", route_length=3.0, success_on="stop",
                    max_episode_steps=900)
     try:
-        controller = baselines.make("bearing-longrange")
+        controller = homing_baselines.make("bearing-longrange")
         prepare_policy(controller, env)
         record = run_episode(env, controller, seed=0)
         outbound = env.unwrapped.task.outbound_steps
@@ -70,10 +70,10 @@ def test_longrange_homes_from_pixels_and_turns_to_the_home_heading():
 ])
 def test_bad_parameters_raise(params, match):
     with pytest.raises(ValueError, match=match):
-        baselines.make("bearing-longrange", **params)
+        homing_baselines.make("bearing-longrange", **params)
 
 
 def test_missing_phase_key_raises():
-    controller = baselines.make("bearing-longrange")
+    controller = homing_baselines.make("bearing-longrange")
     with pytest.raises(ValueError, match="phase"):
         controller.predict({"panorama": np.zeros((64, 256, 3), np.uint8)})

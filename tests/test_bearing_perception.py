@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from baselines.blobs import LAB_COLORS, BlobColor, detect_blobs, largest_blob
-from baselines.klt import CornerTracker, KLTConfig, wrap_columns
+from homing_baselines.blobs import LAB_COLORS, BlobColor, detect_blobs, largest_blob
+from homing_baselines.klt import CornerTracker, KLTConfig, wrap_columns
 from homing_gym.geometry import bearing_to, wrap_angle
 from homing_gym.scenes.lab import MARKED
 

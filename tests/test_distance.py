@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from baselines.distance import (DistanceConfig, DistanceController, LandmarkMap,
+from homing_baselines.distance import (DistanceConfig, DistanceController, LandmarkMap,
                                 assignments, eq1_distance, landmark_distances, localize,
                                 map_from_positions, resect_nest_map)
-from baselines.landmarks_red import Arc
+from homing_baselines.landmarks_red import Arc
 from homing_gym.geometry import wrap_angle
 from test_warping import free_start
 
@@ -156,7 +156,7 @@ def test_controller_reaches_home_from_1m_in_arena():
     one (docs/yu_kim.md), so that episode fails (a limit of the method, not hidden)."""
     gym = pytest.importorskip("gymnasium")
     import homing_gym  # noqa: F401
-    from train.evaluate import prepare_policy, run_episode
+    from homing_train.harness.evaluate import prepare_policy, run_episode
 
     env = gym.make("homing_gym/LocalHoming-v0", obs_keys=("panorama", "goal", "goal_step"),
                    max_episode_steps=300)
@@ -175,7 +175,7 @@ def test_controller_reaches_home_from_1m_in_arena():
 
 
 def test_free_direction_steers_around_a_landmark_ahead():
-    from baselines.distance import free_direction, view_obstacles
+    from homing_baselines.distance import free_direction, view_obstacles
 
     ahead = [(0.5, 0.0, 0.1)]  # a cylinder 0.5 m straight ahead
     d = free_direction(0.0, 0.8, ahead, 0.22)
@@ -192,8 +192,8 @@ def test_free_direction_steers_around_a_landmark_ahead():
 
 def test_run_episodes_takes_a_home_pose_per_task():
     pytest.importorskip("gymnasium")
-    from train.evaluate import run_episodes
-    from train.policies import policy_spec
+    from homing_train.harness.evaluate import run_episodes
+    from homing_train.harness.policies import policy_spec
 
     home, start = (0.3, -0.2, 1.0), (-0.4, 0.5, 0.0)
     recs = run_episodes(policy_spec("oracle"), "homing_gym/LocalHoming-v0",

@@ -9,12 +9,12 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from baselines import Controller
-from baselines.motion import Move
-from train import compare as compare_cli
-from train import evaluate as eval_cli
-from train import field as field_cli
-from train.evaluate import EvalResult, evaluate
+from homing_baselines import Controller
+from homing_baselines.motion import Move
+from homing_train.harness import compare as compare_cli
+from homing_train.harness import evaluate as eval_cli
+from homing_train.harness import field as field_cli
+from homing_train.harness.evaluate import EvalResult, evaluate
 
 ENV_ID = "homing_gym/LocalHoming-v0"
 SHORT = {"max_episode_steps": 8}
@@ -171,7 +171,7 @@ def test_sb3_model_zip_is_evaluated(tmp_path):
 
 
 def test_evaluate_gives_a_controller_the_observation_keys_it_reads():
-    from train.evaluate import evaluate
+    from homing_train.harness.evaluate import evaluate
 
     result = evaluate("distance", episodes=1, seed=3, workers=1, progress=False,
                       env_kwargs={"max_episode_steps": 3})

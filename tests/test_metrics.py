@@ -7,8 +7,8 @@ import pytest
 
 from homing_gym.paths import segment_free, shortest_path
 from homing_gym.scenes.arena import arena_scene
-from train.evaluate import EpisodeRecord, summarize
-from train.metrics import bootstrap_ci, distance_bins, path_length, soft_spl, spl
+from homing_train.harness.evaluate import EpisodeRecord, summarize
+from homing_train.harness.metrics import bootstrap_ci, distance_bins, path_length, soft_spl, spl
 
 # a 3-4-5 detour: straight-line distance 5, travelled 7
 TRAJECTORY = [(0.0, 0.0), (3.0, 0.0), (3.0, 4.0)]

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from baselines.multires_matching import (find_template, front_view, locate_on_path,
+from homing_baselines.multires_matching import (find_template, front_view, locate_on_path,
                                          match_heading, predicted_directions, triangulate)
 from homing_gym.teaching import clip_template
 
@@ -62,11 +62,11 @@ def test_template_found_at_its_subpixel_position_only_inside_the_window():
 @pytest.mark.parametrize("goal, start", [("kitchen", (5.5, 4.55, 0.1)),
                                          ("bedroom", (5.6, 1.45, -0.15))])
 def test_controller_stops_within_10_cm_of_a_work_location_from_1_m_away(make_env, goal, start):
-    import baselines
-    from train.evaluate import prepare_policy, run_episode
+    import homing_baselines
+    from homing_train.harness.evaluate import prepare_policy, run_episode
 
     env = make_env("homing_gym/WorkLocations-v0", goal_location=goal, max_episode_steps=200)
-    controller = baselines.make("multires")
+    controller = homing_baselines.make("multires")
     prepare_policy(controller, env)
     record = run_episode(env, controller, seed=0, start=start)
     assert record.terminated and record.success
@@ -75,12 +75,12 @@ def test_controller_stops_within_10_cm_of_a_work_location_from_1_m_away(make_env
 
 
 def test_controller_refuses_discrete_actions_and_bad_parameters():
-    import baselines
-    from baselines.motion import MotionSpec
+    import homing_baselines
+    from homing_baselines.motion import MotionSpec
 
     with pytest.raises(ValueError, match="continuous"):
-        baselines.make("multires").configure(MotionSpec(action_type="discrete"))
+        homing_baselines.make("multires").configure(MotionSpec(action_type="discrete"))
     with pytest.raises(ValueError, match="scales"):
-        baselines.make("multires", scales=(0.9, 1.1))
+        homing_baselines.make("multires", scales=(0.9, 1.1))
     with pytest.raises(ValueError, match="step_length"):
-        baselines.make("multires", step_length=0.0)
+        homing_baselines.make("multires", step_length=0.0)

@@ -1,4 +1,4 @@
-"""Behaviour cloning on rendered pose pairs (train/pretrain.py)."""
+"""Behaviour cloning on rendered pose pairs (train/learning/pretrain.py)."""
 
 from __future__ import annotations
 
@@ -9,12 +9,12 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-import baselines
-from baselines.motion import FORWARD, LEFT, RIGHT, MotionHelper
+import homing_baselines
+from homing_baselines.motion import FORWARD, LEFT, RIGHT, MotionHelper
 from homing_gym.geometry import wrap_angle
-from train.evaluate import prepare_policy
-from train.pretrain import pair_labels, pair_samples, pair_set, render_bank, rolled
-from train.train import main
+from homing_train.harness.evaluate import prepare_policy
+from homing_train.learning.pretrain import pair_labels, pair_samples, pair_set, render_bank, rolled
+from homing_train.learning.train import main
 
 KWARGS = {"scene": "arena", "panorama_shape": [16, 64], "action_type": "discrete",
           "control_period": 0.2}
@@ -48,7 +48,7 @@ def test_turning_rolls_the_panorama_towards_higher_columns(env):
 def test_pair_labels_turn_towards_the_oracle_waypoint(env):
     """A label is the oracle's first action: forward when its waypoint lies within half a
     turn step of the heading, else a turn towards it (counter-clockwise: left)."""
-    oracle = baselines.make("oracle")
+    oracle = homing_baselines.make("oracle")
     prepare_policy(oracle, env)
     helper = MotionHelper(oracle.motion_spec, oracle.motion)
     bank = render_bank(env, 12, 1, seed=3, progress=False)
@@ -90,8 +90,8 @@ def test_pretraining_runs_from_homing_train_and_records_its_fit(tmp_path):
 def test_pretraining_refuses_other_observation_keys():
     from stable_baselines3 import PPO
 
-    from train.extractor import policy_kwargs_for
-    from train.pretrain import pretrain
+    from homing_train.learning.extractor import policy_kwargs_for
+    from homing_train.learning.pretrain import pretrain
 
     env = gym.make("homing_gym/LocalHoming-v0", obs_keys=("panorama", "goal", "odometry"),
                    **KWARGS)
@@ -107,8 +107,8 @@ def test_init_policy_starts_a_run_from_saved_weights(tmp_path):
     import torch
     from stable_baselines3 import PPO
 
-    from train.extractor import policy_kwargs_for
-    from train.train import load_policy_weights
+    from homing_train.learning.extractor import policy_kwargs_for
+    from homing_train.learning.train import load_policy_weights
 
     env = gym.make("homing_gym/LocalHoming-v0", **KWARGS)
     make = lambda seed, dim: PPO("MultiInputPolicy", env, n_steps=16, batch_size=16,  # noqa: E731

@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from baselines.camera_models import PanoramaModel, PerspectiveModel
-from baselines.selfsimilar_detector import (DetectorConfig, detect_landmarks,
+from homing_baselines.camera_models import PanoramaModel, PerspectiveModel
+from homing_baselines.selfsimilar_detector import (DetectorConfig, detect_landmarks,
                                             match_function)
 from homing_gym.selfsimilar import (BARCODE_BANDS, MAX_ID, PanelLayout, barcode_bits,
                                     decode_barcode, panel_image, self_similar)

@@ -9,26 +9,26 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-import baselines
-import baselines.selfsimilar as selfsimilar
-from baselines.motion import Move
-from baselines.selfsimilar_detector import Detection
-from baselines.selfsimilar_panel import PanelPose
+import homing_baselines
+import homing_baselines.selfsimilar as selfsimilar
+from homing_baselines.motion import Move
+from homing_baselines.selfsimilar_detector import Detection
+from homing_baselines.selfsimilar_panel import PanelPose
 from homing_gym.geometry import wrap_angle
 from homing_gym.tasks.landmark_navigation import N_IDS
-from train.evaluate import prepare_policy, run_episode
+from homing_train.harness.evaluate import prepare_policy, run_episode
 
 
 def test_registered_with_its_observation_keys_and_checks_its_parameters():
-    c = baselines.make("selfsimilar", planning="probabilistic")
+    c = homing_baselines.make("selfsimilar", planning="probabilistic")
     assert isinstance(c, selfsimilar.SelfSimilarController)
     assert c.observation_keys() == ("view", "goal_id", "odometry")
     with pytest.raises(ValueError, match="planning 'astar'.*deterministic"):
-        baselines.make("selfsimilar", planning="astar")
+        homing_baselines.make("selfsimilar", planning="astar")
     with pytest.raises(ValueError, match="scan_step_deg"):
-        baselines.make("selfsimilar", scan_step_deg=90.0)
+        homing_baselines.make("selfsimilar", scan_step_deg=90.0)
     with pytest.raises(ValueError, match="standoff"):
-        baselines.make("selfsimilar", standoff=0.0)
+        homing_baselines.make("selfsimilar", standoff=0.0)
     with pytest.raises(ValueError, match="odometry"):
         c.decide({"view": np.zeros((240, 320, 3), np.uint8),
                   "goal_id": np.eye(N_IDS, dtype=np.float32)[0]})
@@ -43,7 +43,7 @@ def test_reaches_a_visible_goal_and_stops_in_front_of_it():
     try:
         env.reset(seed=5)
         assert env.unwrapped.task.goal_id == 9
-        c = baselines.make("selfsimilar")
+        c = homing_baselines.make("selfsimilar")
         prepare_policy(c, env)
         record = run_episode(env, c, seed=5, start=[6.0, 3.0, 1.2])
     finally:
@@ -116,7 +116,7 @@ def _controller(monkeypatch, world: FakeWorld, planning: str):
     from it; its own frame is the world's)."""
     monkeypatch.setattr(selfsimilar, "detect_landmarks", world.detections)
     monkeypatch.setattr(selfsimilar, "panel_pose", world.panel_pose)
-    c = baselines.make("selfsimilar", planning=planning)
+    c = homing_baselines.make("selfsimilar", planning=planning)
     c.reset(seed=0)
     c.at = 0
     return c

@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from baselines.selfsimilar_graph import VisibilityGraph
+from homing_baselines.selfsimilar_graph import VisibilityGraph
 
 
 def _graph(p_direct: float, looks: int = 10) -> VisibilityGraph:

@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from baselines.camera_models import PerspectiveModel
-from baselines.selfsimilar_detector import DetectorConfig, detect_landmarks
+from homing_baselines.camera_models import PerspectiveModel
+from homing_baselines.selfsimilar_detector import DetectorConfig, detect_landmarks
 from homing_gym.scenes import scene_factory
 from homing_gym.scenes.base import Scene, square_walls
 from homing_gym.scenes.corridors import wall_panel
@@ -84,7 +84,7 @@ def test_corridors_visibility_graph_is_connected_on_rendered_scans():
     import gymnasium as gym
     import networkx as nx
 
-    from train.selfsimilar_figures import panel_area, scan_visibility
+    from homing_train.figures.selfsimilar import panel_area, scan_visibility
 
     e = gym.make("homing_gym/LandmarkNavigation-v0")
     try:

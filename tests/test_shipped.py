@@ -2,8 +2,8 @@
 
 import pytest
 
-from train.evaluate import DEFAULT_ENV, evaluate
-from train.suite import shipped_policies
+from homing_train.harness.evaluate import DEFAULT_ENV, evaluate
+from homing_train.harness.suite import shipped_policies
 
 SHIPPED = shipped_policies()
 

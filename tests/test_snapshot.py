@@ -8,13 +8,13 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-import baselines
-from baselines.motion import MotionSpec
-from baselines.signature import (bearing_grid, characteristic_points, monotonic_segments,
+import homing_baselines
+from homing_baselines.motion import MotionSpec
+from homing_baselines.signature import (bearing_grid, characteristic_points, monotonic_segments,
                                  signature_from_omni, signature_from_panorama)
-from baselines.snapshot import HongConfig, SnapshotController, harmonic_weights, hong_homing
+from homing_baselines.snapshot import HongConfig, SnapshotController, harmonic_weights, hong_homing
 from homing_gym.geometry import wrap_angle
-from train.hong_figures import render_pairs
+from homing_train.figures.hong import render_pairs
 
 PANORAMA = (60, 360)
 
@@ -49,7 +49,7 @@ def test_omni_and_panorama_signatures_agree(hallway_views):
 
 
 def test_panorama_signature_is_the_env_signature_in_bearing_order(hallway_views):
-    from baselines.signature import columns_to_bearings
+    from homing_baselines.signature import columns_to_bearings
     np.testing.assert_allclose(signature_from_panorama(hallway_views["panorama"]),
                                columns_to_bearings(hallway_views["signature"]), atol=1e-6)
     # the bearing grid: column centres of a 360-wide panorama, counter-clockwise
@@ -145,10 +145,10 @@ def test_config_validation():
 
 # -- the controller -------------------------------------------------------------------------
 def test_registered_and_needs_its_observation_keys():
-    controller = baselines.make("snapshot", k_back=20.0)
+    controller = homing_baselines.make("snapshot", k_back=20.0)
     assert isinstance(controller, SnapshotController)
     with pytest.raises(ValueError, match="goal_omni"):
-        baselines.make("snapshot", source="omni").decide({"panorama": np.zeros((60, 360, 3))})
+        homing_baselines.make("snapshot", source="omni").decide({"panorama": np.zeros((60, 360, 3))})
 
 
 def test_stops_then_restarts_when_the_goal_changes(hallway_views):
@@ -189,7 +189,7 @@ def test_route_first_targets_in_stop_mode(make_env):
                    "red cylinders 0.5 m from its centre) is smaller than 0.5 m: see docs/hong.md")
 def test_controller_reaches_home_from_half_a_metre_in_the_arena(make_env):
     env = make_env(panorama_shape=PANORAMA, start_distance=(0.5, 0.5), success_on="stop")
-    from train.evaluate import prepare_policy, run_episode
+    from homing_train.harness.evaluate import prepare_policy, run_episode
 
     c = SnapshotController()
     prepare_policy(c, env)

@@ -7,8 +7,8 @@ import pytest
 import torch
 import yaml
 
-from train.extractor import CircularConv, PanoramaGoalExtractor
-from train.train import latest_checkpoint, load_hyperparams, main, make_config, parse_overrides
+from homing_train.learning.extractor import CircularConv, PanoramaGoalExtractor
+from homing_train.learning.train import latest_checkpoint, load_hyperparams, main, make_config, parse_overrides
 
 # 36 rows: the smallest height SB3's NatureCNN (inside CombinedExtractor) accepts
 TINY = ["--env-kwargs", json.dumps({"panorama_shape": [36, 64], "max_episode_steps": 16}),
@@ -40,7 +40,7 @@ def test_save_load_round_trip_gives_identical_actions(tmp_path):
     import gymnasium as gym
     from stable_baselines3 import PPO
 
-    from train.extractor import policy_kwargs_for
+    from homing_train.learning.extractor import policy_kwargs_for
 
     env = gym.make("homing_gym/LocalHoming-v0", panorama_shape=(36, 64), max_episode_steps=16)
     model = PPO("MultiInputPolicy", env, n_steps=32, batch_size=16, n_epochs=1, seed=0,
@@ -112,7 +112,7 @@ def test_extractor_fuses_current_and_goal_early():
 
 
 def test_suite_evaluates_and_compares_methods_on_one_suite(tmp_path, capsys):
-    from train.suite import main as suite_main
+    from homing_train.harness.suite import main as suite_main
 
     assert suite_main(["--methods", "oracle", "--episodes", "2", "--workers", "1",
                        "--out", str(tmp_path)]) == 0
@@ -125,7 +125,7 @@ def test_suite_evaluates_and_compares_methods_on_one_suite(tmp_path, capsys):
 
 
 def test_ship_copies_the_best_model_with_eval_settings_and_curve(tmp_path):
-    from train.ship import ship_run
+    from homing_train.learning.ship import ship_run
 
     run = tmp_path / "run"
     run.mkdir()
@@ -162,8 +162,8 @@ def test_stochastic_evaluation_of_a_model_is_reproducible_per_episode(tmp_path):
     import gymnasium as gym
     from stable_baselines3 import PPO
 
-    from train.evaluate import evaluate
-    from train.extractor import policy_kwargs_for
+    from homing_train.harness.evaluate import evaluate
+    from homing_train.learning.extractor import policy_kwargs_for
 
     kwargs = {"panorama_shape": [16, 64], "max_episode_steps": 12, "action_type": "discrete"}
     env = gym.make("homing_gym/LocalHoming-v0", **kwargs)
@@ -192,18 +192,18 @@ def test_imitation_fits_the_policy_to_the_oracle_labels(tmp_path):
     import gymnasium as gym
     from stable_baselines3 import PPO
 
-    from train.extractor import policy_kwargs_for
-    from train.imitation import collect, dagger, fit
+    from homing_train.learning.extractor import policy_kwargs_for
+    from homing_train.learning.imitation import collect, dagger, fit
 
     kwargs = {"panorama_shape": [16, 64], "max_episode_steps": 40, "action_type": "discrete",
               "control_period": 0.2}
     env = gym.make("homing_gym/LocalHoming-v0", **kwargs)
     model = PPO("MultiInputPolicy", env, n_steps=16, batch_size=16, n_epochs=1, seed=0,
                 learning_rate=1e-3, policy_kwargs=policy_kwargs_for("panorama", features_dim=16))
-    import baselines
-    from train.evaluate import prepare_policy
+    import homing_baselines
+    from homing_train.harness.evaluate import prepare_policy
 
-    oracle = baselines.make("oracle")
+    oracle = homing_baselines.make("oracle")
     prepare_policy(oracle, env)
     rng = np.random.default_rng(0)
     obs, labels, before = collect(env, oracle, model, 1.0, 3, 100, rng)
@@ -227,7 +227,7 @@ def test_imitation_fits_the_policy_to_the_oracle_labels(tmp_path):
 
 
 def test_suite_runs_the_controllers_made_for_the_env():
-    from train.suite import suite_methods
+    from homing_train.harness.suite import suite_methods
 
     local = suite_methods("homing_gym/LocalHoming-v0")
     assert {"oracle", "random", "snapshot", "warping", "distance"} <= set(local)

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from baselines.warping import (WarpingConfig, WarpingController, warp_bearings, warp_search,
+from homing_baselines.warping import (WarpingConfig, WarpingController, warp_bearings, warp_search,
                                warping_homing)
 from homing_gym.geometry import wrap_angle
 from homing_gym.panorama import column_bearing
@@ -96,7 +96,7 @@ def test_rendered_pairs_03m_apart_point_home(arena):
 
 
 def test_controller_reaches_home_from_05m(arena):
-    from train.evaluate import prepare_policy, run_episode
+    from homing_train.harness.evaluate import prepare_policy, run_episode
 
     controller = WarpingController()
     prepare_policy(controller, arena)

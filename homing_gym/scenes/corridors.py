@@ -5,7 +5,7 @@ An 8 x 6 m floor: four 4 x 2.4 m rooms, two south (A, B) and two north (C, D) of
 1.2 m wide corridor running east-west (y from 2.4 to 3.6 m), each room opening onto it
 through a 1.2 m door. Walls are 1.2 m high and light grey, the floor light grey
 (the detector's barcode reader needs light surroundings, see
-:mod:`baselines.selfsimilar_detector`). Fourteen landmark panels
+:mod:`homing_baselines.selfsimilar_detector`). Fourteen landmark panels
 (:func:`wall_panel`, :mod:`homing_gym.selfsimilar`, ids 0-13) hang on the walls with
 the pattern centred at camera height: two in each room on the wall facing its door, one
 on each end wall of the corridor and one opposite each door (see :data:`PANELS`: the
@@ -45,7 +45,7 @@ DOORS_NORTH = (3.0, 5.0)
 #: see along the corridor. So every panel is reachable from every other one over the
 #: visibility graph (§4.1), as in the paper's environment, where landmarks are seen from
 #: room to corridor and along it (checked on rendered views by
-#: ``python -m train.selfsimilar_figures layout`` and ``tests/test_selfsimilar_render.py``).
+#: ``python -m homing_train.figures.selfsimilar layout`` and ``tests/test_selfsimilar_render.py``).
 PANELS = (
     (0, 1.4, 0.0, 90), (1, 2.6, 0.0, 90),          # room A (south-west)
     (2, 5.5, 0.0, 90), (3, 6.7, 0.0, 90),          # room B (south-east)

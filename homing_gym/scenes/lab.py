@@ -11,7 +11,7 @@ The paper's panels were flat posters seen from the workspace; ours are four-side
 effect (cylinders), so that the centroid of the blob is the bearing of the column's
 axis from everywhere, including from the wedges ``H^`` behind the landmarks. Nothing
 else in the room is strongly saturated in the three poster hues
-(:data:`baselines.blobs.LAB_COLORS`).
+(:data:`homing_baselines.blobs.LAB_COLORS`).
 
 ``scene.metadata``:
 
@@ -21,7 +21,7 @@ else in the room is strongly saturated in the three poster hues
   through the landmarks, outside the triangle), ``C`` and ``D`` in ``H^`` (behind
   ``L1`` and ``L2``), ``B`` and ``E`` in the rest of the plane. Each lies at least
   0.2 m from the boundaries of its region (``tests/test_lab_scene.py`` checks with
-  :func:`baselines.bearing_sim.region`).
+  :func:`homing_baselines.bearing_sim.region`).
 """
 
 from __future__ import annotations

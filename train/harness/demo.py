@@ -32,10 +32,10 @@ from homing_gym.panorama import bearing_column  # noqa: E402
 
 def run_episode(env: gym.Env, seed: int, controller_name: str = "oracle"):
     """Frames and final info of one episode driven by a registered controller."""
-    import baselines
-    from baselines.motion import MotionSpec
+    import homing_baselines
+    from homing_baselines.motion import MotionSpec
 
-    controller = baselines.make(controller_name)
+    controller = homing_baselines.make(controller_name)
     controller.configure(MotionSpec.from_env(env))
     if controller.needs_env:
         controller.attach_env(env)

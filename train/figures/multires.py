@@ -1,12 +1,12 @@
 """Figures and numbers of docs/multires.md (Shiraishi & Sawasaki multi-resolution matching).
 
-``python -m train.multires_figures localisation --out docs/multires``: self-localisation
+``python -m homing_train.figures.multires localisation --out docs/multires``: self-localisation
 (§4(2-2), Fig. 10) at every point of a grid within 0.5 m of each work location of the
 ``house`` and several headings, with and without daily changes; error distributions
 (``localisation.png``), summary (``localisation.json``) and localisations per second on
 one core (the ``localise`` call alone, and with rendering the panorama).
 
-``python -m train.multires_figures travel --episodes 30 --out docs/multires``: seeded
+``python -m homing_train.figures.multires travel --episodes 30 --out docs/multires``: seeded
 ``WorkLocations-v0`` episodes run by the ``multires`` controller; per episode the
 distance to the target when the arrival decision (Fig. 5) declares "approximately at
 the work location", the final stop distance and success (``travel.json``,
@@ -26,13 +26,13 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 
-import baselines
+import homing_baselines
 import homing_gym
-from baselines.multires import LOCALISE
-from baselines.multires_localise import localise
+from homing_baselines.multires import LOCALISE
+from homing_baselines.multires_localise import localise
 from homing_gym.scenes.base import clearance
 from homing_gym.teaching import FeatureMap
-from train.evaluate import prepare_policy
+from homing_train.harness.evaluate import prepare_policy
 
 ENV_ID = "homing_gym/WorkLocations-v0"
 LOCATIONS = ("home", "kitchen", "bedroom")
@@ -103,7 +103,7 @@ def summarise_localisation(rows: list[dict]) -> dict:
 def travel_experiment(episodes: int, seed: int, daily_changes: float) -> list[dict]:
     gym.register_envs(homing_gym)
     env = gym.make(ENV_ID, daily_changes=daily_changes)
-    controller = baselines.make("multires")
+    controller = homing_baselines.make("multires")
     prepare_policy(controller, env)
     rows = []
     for s in range(seed, seed + episodes):

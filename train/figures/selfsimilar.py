@@ -1,9 +1,9 @@
 """Measurements for the self-similar landmarks of Briggs, Scharstein et al. 2000 (issue 8).
 
-    python -m train.selfsimilar_figures speed --out docs/selfsimilar
-    python -m train.selfsimilar_figures detection --out docs/selfsimilar
-    python -m train.selfsimilar_figures layout --out docs/selfsimilar
-    python -m train.selfsimilar_figures nav --runs RUNS --out docs/selfsimilar
+    python -m homing_train.figures.selfsimilar speed --out docs/selfsimilar
+    python -m homing_train.figures.selfsimilar detection --out docs/selfsimilar
+    python -m homing_train.figures.selfsimilar layout --out docs/selfsimilar
+    python -m homing_train.figures.selfsimilar nav --runs RUNS --out docs/selfsimilar
 
 ``speed``: detector frame rate on one core at 640 x 480 and 320 x 240 (the paper's
 sizes), with and without the §3.3 speed-ups (every 2k-th scanline first; peak scan
@@ -31,7 +31,7 @@ connected) and prints the edges.
 ``nav``: merges the ``homing-eval`` results of ``LandmarkNavigation-v0`` run in chunks
 of seeds, ``RUNS/nav_<planning>_<clean|changed>_s<first seed>.json``, into
 ``nav_<planning>_<clean|changed>.json`` (+ .csv) under ``--out`` and prints the
-results table: success with its 95 % bootstrap interval (:func:`train.metrics.bootstrap_ci`),
+results table: success with its 95 % bootstrap interval (:func:`homing_train.harness.metrics.bootstrap_ci`),
 median path length and shortest path of the successes, steps, collisions.
 """
 
@@ -47,8 +47,8 @@ from typing import Sequence
 
 import numpy as np
 
-from baselines.camera_models import PerspectiveModel
-from baselines.selfsimilar_detector import DetectorConfig, detect_landmarks
+from homing_baselines.camera_models import PerspectiveModel
+from homing_baselines.selfsimilar_detector import DetectorConfig, detect_landmarks
 
 #: Frames per second reported by the paper (§3.3) with the speed-ups.
 PAPER_FPS = {(640, 480): 36.0, (320, 240): 81.0}
@@ -162,7 +162,7 @@ def _viewpoints(distance: float, angle_deg: float):
 
 def measure_detection() -> list[dict]:
     """One row per condition: images, hits, false positives."""
-    from baselines.camera_models import PerspectiveModel
+    from homing_baselines.camera_models import PerspectiveModel
 
     model = PerspectiveModel.from_fov(*VIEW_SIZE, VIEW_HFOV)
     grids = [(1.0, 0.0, DISTANCES, ANGLES)]
@@ -309,7 +309,7 @@ def merge_nav_runs(runs: str, out: str) -> dict:
     merged result's seed is the smallest chunk's."""
     import glob
 
-    from train.evaluate import EvalResult
+    from homing_train.harness.evaluate import EvalResult
 
     merged = {}
     for planning in PLANNINGS:
@@ -348,7 +348,7 @@ def nav_table(merged: dict) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m train.selfsimilar_figures",
+    parser = argparse.ArgumentParser(prog="python -m homing_train.figures.selfsimilar",
                                      description=__doc__.split("\n")[0])
     parser.add_argument("what", choices=["speed", "detection", "layout", "nav"])
     parser.add_argument("--runs", help="nav: folder of the chunked homing-eval results")

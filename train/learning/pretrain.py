@@ -11,12 +11,12 @@ panoramas). So ``N`` panoramas rendered at heading 0 at free floor positions giv
 ``j`` and heading ``m``). Each pair is labelled with the oracle's action from pose
 ``(x_i, y_i, k)`` towards home ``j``: its waypoint on the true shortest path (a function
 of the two positions, computed once per pair) turned into the env's first discrete or
-continuous command (:class:`baselines.motion.MotionHelper`). The home heading never
+continuous command (:class:`homing_baselines.motion.MotionHelper`). The home heading never
 changes the label, and the current heading only rotates the bearing, so the headings are
 drawn afresh for every sample: every pass sees new images.
 
 The policy network is fitted by maximum likelihood of the labels
-(:func:`train.imitation.fit`), on fresh samples each chunk; its agreement with the oracle
+(:func:`homing_train.learning.imitation.fit`), on fresh samples each chunk; its agreement with the oracle
 is measured on pairs from a separate bank of positions. The oracle's ground truth labels
 training data only; the policy acts from the two images.
 """
@@ -30,12 +30,12 @@ import gymnasium as gym
 import numpy as np
 from tqdm.auto import tqdm
 
-import baselines
-from baselines.motion import MotionHelper
+import homing_baselines
+from homing_baselines.motion import MotionHelper
 from homing_gym.scenes.base import Scene
 from homing_gym.tasks.base import sample_free_pose
-from train.evaluate import prepare_policy
-from train.imitation import fit
+from homing_train.harness.evaluate import prepare_policy
+from homing_train.learning.imitation import fit
 
 #: Observation keys a bank can produce.
 BANK_KEYS = ("panorama", "goal")
@@ -191,7 +191,7 @@ def pretrain(model, env_id: str, env_kwargs: dict, positions: int, scenes: int,
         env.close()
         raise ValueError(f"pretraining on pose pairs needs obs_keys {BANK_KEYS}, the env "
                          f"has {keys}")
-    oracle = baselines.make("oracle")
+    oracle = homing_baselines.make("oracle")
     prepare_policy(oracle, env)
     helper = MotionHelper(oracle.motion_spec, oracle.motion)
     task = env.unwrapped.task

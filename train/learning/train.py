@@ -3,7 +3,7 @@
     homing-train --env homing_gym/LocalHoming-v0 --seed 0 --timesteps 300000 --out runs/ppo
     homing-train --resume runs/ppo          # continue from the last checkpoint
 
-Hyperparameters come from ``train/hyperparams/ppo.yml`` (keyed by env id, with a
+Hyperparameters come from ``train/learning/hyperparams/ppo.yml`` (keyed by env id, with a
 ``default`` entry), then ``--hyperparams FILE``, then ``--hp KEY=VALUE`` (values parsed as
 YAML), then the dedicated flags. A run folder holds ``model.zip`` (final),
 ``best_model.zip`` and ``evaluations.npz`` (``EvalCallback`` on held-out seeds, with
@@ -33,11 +33,11 @@ import numpy as np
 import yaml
 
 import homing_gym
-from train.extractor import EXTRACTORS, policy_kwargs_for
-from train.imitation import dagger
-from train.pretrain import pretrain
+from homing_train.learning.extractor import EXTRACTORS, policy_kwargs_for
+from homing_train.learning.imitation import dagger
+from homing_train.learning.pretrain import pretrain
 
-HYPERPARAMS = Path(str(resources.files("train") / "hyperparams" / "ppo.yml"))
+HYPERPARAMS = Path(str(resources.files("homing_train.learning") / "hyperparams" / "ppo.yml"))
 PPO_KEYS = ("n_steps", "batch_size", "n_epochs", "learning_rate", "gamma", "gae_lambda",
             "clip_range", "ent_coef", "vf_coef", "max_grad_norm")
 EVAL_SEED_OFFSET = 1_000_000

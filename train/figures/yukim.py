@@ -1,7 +1,7 @@
 """Yu & Kim (2011) evaluation in the ``arena``: Figs. 4-6 and the Eq. 1 distance errors.
 
-Distance estimation (``distance``, :mod:`baselines.distance`) against Franz et al. 1998
-warping (``warping``, :mod:`baselines.warping`), both without a compass.
+Distance estimation (``distance``, :mod:`homing_baselines.distance`) against Franz et al. 1998
+warping (``warping``, :mod:`homing_baselines.warping`), both without a compass.
 
 * ``fields``: on a grid over the free floor (spacing ``--grid``, random headings), the
   robot takes the first view, steps ``STEP`` m straight ahead, takes the second, and
@@ -16,16 +16,16 @@ warping (``warping``, :mod:`baselines.warping`), both without a compass.
 * ``success``: Fig. 6, success rate of ``--trials`` closed-loop LocalHoming-v0 episodes
   per start-distance bin to a fixed nest at the arena centre (``HOME_POSE``; starts
   uniform in each bin, random headings; ``FIG6_STEPS`` steps at most), the same tasks for
-  both controllers (:func:`fig6_tasks`, :func:`train.evaluate.run_episodes` with a home
+  both controllers (:func:`fig6_tasks`, :func:`homing_train.harness.evaluate.run_episodes` with a home
   pose per task): ``fig6_success.png`` and ``success.json`` (Wilson 95% intervals).
 * ``eval``: the 200-episode LocalHoming-v0 suite of a controller (as ``homing-eval``;
   ``distance`` gets the ``goal_step`` observation, the paper's second nest snapshot).
 
 Command line::
 
-    python -m train.yukim_figures fields --out docs/yu_kim
-    python -m train.yukim_figures success --out docs/yu_kim --trials 100 --workers 2
-    python -m train.yukim_figures eval --policy distance --episodes 200 --workers 2 \\
+    python -m homing_train.figures.yukim fields --out docs/yu_kim
+    python -m homing_train.figures.yukim success --out docs/yu_kim --trials 100 --workers 2
+    python -m homing_train.figures.yukim eval --policy distance --episodes 200 --workers 2 \\
         --out results/distance.json
 """
 
@@ -46,11 +46,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
-import baselines  # noqa: E402
+import homing_baselines  # noqa: E402
 import homing_gym  # noqa: E402,F401
-from baselines.distance import (DistanceConfig, DistanceController, build_nest_map,  # noqa: E402
+from homing_baselines.distance import (DistanceConfig, DistanceController, build_nest_map,  # noqa: E402
                                 distance_homing)
-from baselines.warping import WarpingConfig, WarpingController, warping_homing  # noqa: E402
+from homing_baselines.warping import WarpingConfig, WarpingController, warping_homing  # noqa: E402
 from homing_gym.geometry import wrap_angle  # noqa: E402
 from homing_gym.scenes.base import clearance  # noqa: E402
 from homing_gym.topdown import HOME, MapCanvas, draw_pose, draw_scene  # noqa: E402
@@ -65,8 +65,8 @@ CONTROLLERS = {"distance": DistanceController, "warping": WarpingController}
 def register_controllers() -> None:
     """Register ``distance`` and ``warping`` (until ``baselines/__init__.py`` does)."""
     for name, cls in CONTROLLERS.items():
-        if name not in baselines.available():
-            baselines.register(name, cls)
+        if name not in homing_baselines.available():
+            homing_baselines.register(name, cls)
 
 
 def t_quantile(p: float, dof: int) -> float:
@@ -341,8 +341,8 @@ def run_success(out: str, trials: int, workers: int, seed: int, bins=FIG6_BINS,
                 max_steps: int = FIG6_STEPS) -> dict:
     """Fig. 6: ``trials`` episodes per start-distance bin to the fixed nest, both methods
     on the same tasks (``distance`` with the ``goal_step`` nest snapshot)."""
-    from train.evaluate import run_episodes
-    from train.policies import policy_spec
+    from homing_train.harness.evaluate import run_episodes
+    from homing_train.harness.policies import policy_spec
 
     kwargs = {"obs_keys": ["panorama", "goal", "goal_step"], "max_episode_steps": max_steps}
     tasks = fig6_tasks(trials, seed, bins)
@@ -390,7 +390,7 @@ def plot_success(results: dict, trials: int, max_steps: int, path: str) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m train.yukim_figures",
+    parser = argparse.ArgumentParser(prog="python -m homing_train.figures.yukim",
                                      description=__doc__.split("\n")[0])
     parser.add_argument("what", choices=("fields", "success", "eval"))
     parser.add_argument("--out", default="docs/yu_kim", help="output folder (eval: JSON path)")
@@ -404,7 +404,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     register_controllers()
     if args.what == "eval":
-        from train.evaluate import evaluate, format_summary
+        from homing_train.harness.evaluate import evaluate, format_summary
 
         kwargs = ({"obs_keys": ["panorama", "goal", "goal_step"]} if args.policy == "distance"
                   else {})

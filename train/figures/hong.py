@@ -2,8 +2,8 @@
 al. 1998 (``warping``): homing vector fields, LocalHoming-v0 suites, RouteFollowing-v0
 routes with and without an illumination change, and the sweep of the paper-open constants.
 
-    python -m train.hong_figures --out docs/hong            # everything
-    python -m train.hong_figures --out docs/hong --only sweep field eval route
+    python -m homing_train.figures.hong --out docs/hong            # everything
+    python -m homing_train.figures.hong --out docs/hong --only sweep field eval route
 
 Writes PNG/JSON files and ``results.json`` under ``--out``; prints Markdown tables.
 Sizes are the issue's: 200 LocalHoming episodes per setting, 20 routes per setting.
@@ -24,14 +24,14 @@ import gymnasium as gym
 import numpy as np
 from tqdm import tqdm
 
-import baselines
+import homing_baselines
 import homing_gym
-from baselines.snapshot import HongConfig, hong_homing
+from homing_baselines.snapshot import HongConfig, hong_homing
 from homing_gym.geometry import bearing_to, wrap_angle
 from homing_gym.scenes.base import clearance
-from train.evaluate import evaluate, prepare_policy
-from train.field import homing_field, plot_field
-from train.policies import policy_spec
+from homing_train.harness.evaluate import evaluate, prepare_policy
+from homing_train.harness.field import homing_field, plot_field
+from homing_train.harness.policies import policy_spec
 
 PANORAMA = (60, 360)   # 1 deg per column, Hong's sampling interval
 LOCAL = "homing_gym/LocalHoming-v0"
@@ -123,7 +123,7 @@ def plot_signature(out: str, seed: int = 3) -> dict[str, Any]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from baselines.signature import characteristic_points, signature_from_omni, \
+    from homing_baselines.signature import characteristic_points, signature_from_omni, \
         signature_from_panorama
 
     env = gym.make(LOCAL, scene="hallway", panorama_shape=PANORAMA, omni_size=256,
@@ -283,10 +283,10 @@ def main(argv: list[str] | None = None) -> int:
         print(markdown_tables(results))
         return 0
     names = methods() if args.methods is None else args.methods
-    unknown = sorted(set(names) - set(baselines.available()))
+    unknown = sorted(set(names) - set(homing_baselines.available()))
     if unknown:
         parser.exit(2, f"hong-figures: unknown controllers {unknown}; "
-                       f"available: {baselines.available()}\n")
+                       f"available: {homing_baselines.available()}\n")
     print(f"methods: {names}")
     steps = {"signature": lambda: plot_signature(args.out), "sweep": lambda: run_sweep(), "field": lambda: run_fields(args.out, names),
              "eval": lambda: run_eval(names, args.episodes),

@@ -1,7 +1,7 @@
 """Figures for Bekris, Argyros & Kavraki's bearing-only homing laws (issue 5), from the
-pure 2-D simulator :mod:`baselines.bearing_sim`.
+pure 2-D simulator :mod:`homing_baselines.bearing_sim`.
 
-    python -m train.bearing_figures reachability --out docs/bearing
+    python -m homing_train.figures.bearing reachability --out docs/bearing
 
 ``reachability`` draws maps like the paper's Fig. 4: a fixed start ``A``, every goal of
 a grid painted gray if the law reaches it (basic, complementary, unified), with the
@@ -10,13 +10,13 @@ marked. Writes ``reachability_<law>.png``, ``reachability.png`` (the three side 
 and ``reachability.json`` (per-region fractions) under ``--out``, and prints a Markdown
 table of the fractions.
 
-    python -m train.bearing_figures starts --out docs/bearing
+    python -m homing_train.figures.bearing starts --out docs/bearing
 
 ``starts`` repeats the unified law's map (coarser grid, no figure) from starts in every
 region and writes ``starts.json`` and a Markdown table: how much depends on ``A``.
 
-    python -m train.bearing_figures fig10 --out docs/bearing
-    python -m train.bearing_figures fig11 --runs 30 --out docs/bearing
+    python -m homing_train.figures.bearing fig10 --out docs/bearing
+    python -m homing_train.figures.bearing fig11 --runs 30 --out docs/bearing
 
 From pixels, in PyBullet: the registered controllers ``bearing-basic``,
 ``bearing-complementary`` and ``bearing`` (unified) in the ``lab`` scene
@@ -28,8 +28,8 @@ law to each marked position ``A``-``F`` from ``--runs`` seeded random starts; me
 standard deviation of the final error. Both write JSON and print Markdown tables beside
 the paper's numbers.
 
-    python -m train.bearing_figures pixel-reachability --out docs/bearing
-    python -m train.bearing_figures longrange --episodes 10 --out docs/bearing
+    python -m homing_train.figures.bearing pixel-reachability --out docs/bearing
+    python -m homing_train.figures.bearing longrange --episodes 10 --out docs/bearing
 
 ``pixel-reachability`` is the Fig. 4 map measured from pixels: the three laws from one
 start to a coarse grid of goals in the lab (``pixel_reachability.png`` and ``.json``).
@@ -52,8 +52,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
-from baselines.bearing_laws import LAWS  # noqa: E402
-from baselines.bearing_sim import (ReachabilityMap, SimConfig, circumcircle,  # noqa: E402
+from homing_baselines.bearing_laws import LAWS  # noqa: E402
+from homing_baselines.bearing_sim import (ReachabilityMap, SimConfig, circumcircle,  # noqa: E402
                                    reachability_map, region)
 
 #: The landmark triangle of the figures (m): scalene, about 2 m a side.
@@ -237,10 +237,10 @@ def lab_run(env, law: str, start: Sequence[float], goal: str | Sequence[float],
     """One pixel run of ``law`` (a key of :data:`PIXEL_LAWS`) in the lab from ``start``
     ``(x, y, yaw)`` to ``goal``, a marked position's name or a point ``(x, y)`` (m):
     final error (cm), stopped, steps."""
-    import baselines
-    from train.evaluate import prepare_policy, run_episode
+    import homing_baselines
+    from homing_train.harness.evaluate import prepare_policy, run_episode
 
-    controller = baselines.make(PIXEL_LAWS[law])
+    controller = homing_baselines.make(PIXEL_LAWS[law])
     prepare_policy(controller, env)
     xy = env.unwrapped.scene.metadata["marked"][goal] if isinstance(goal, str) else goal
     record = run_episode(env, controller, seed, start=start, home=(*xy, GOAL_YAW))
@@ -270,7 +270,7 @@ def _cell(run: dict, fail_cm: float) -> str:
 def fig10(out: str, max_steps: int = 800, fail_cm: float = 20.0,
           progress: bool = True) -> list[dict]:
     """The Fig. 10 experiment from pixels (module docstring); writes ``fig10.json``."""
-    from baselines.bearing_sim import region
+    from homing_baselines.bearing_sim import region
     from homing_gym.scenes.lab import POSTERS
 
     triangle = np.array([pos for _, pos in POSTERS.values()])
@@ -438,9 +438,9 @@ def longrange(out: str, episodes: int = 10, seed: int = 0, route_length: float =
     it ends (``homing_from_m``: distance to home at the end of the outbound route)."""
     import gymnasium as gym
 
-    import baselines
+    import homing_baselines
     import homing_gym
-    from train.evaluate import prepare_policy, run_episode
+    from homing_train.harness.evaluate import prepare_policy, run_episode
 
     gym.register_envs(homing_gym)
     env = gym.make("homing_gym/LongRangeHoming-v0", route_length=route_length,
@@ -449,7 +449,7 @@ def longrange(out: str, episodes: int = 10, seed: int = 0, route_length: float =
     rows: list[dict] = []
     for s in tqdm(range(seed, seed + episodes), desc="long-range episodes",
                   disable=not progress):
-        controller = baselines.make("bearing-longrange")
+        controller = homing_baselines.make("bearing-longrange")
         prepare_policy(controller, env)
         record = run_episode(env, controller, s)
         outbound = env.unwrapped.task.outbound_steps

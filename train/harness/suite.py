@@ -17,17 +17,18 @@ from __future__ import annotations
 import argparse
 import sys
 from dataclasses import dataclass
+from importlib import resources
 from pathlib import Path
 
 import gymnasium as gym
 import yaml
 
-import baselines
+import homing_baselines
 import homing_gym  # noqa: F401  (registers the env ids)
-from train.compare import compare
-from train.evaluate import DEFAULT_ENV, evaluate, format_summary
+from homing_train.harness.compare import compare
+from homing_train.harness.evaluate import DEFAULT_ENV, evaluate, format_summary
 
-POLICY_DIR = Path(__file__).resolve().parent / "shipped"
+POLICY_DIR = Path(str(resources.files("homing_train") / "shipped"))
 
 
 @dataclass(frozen=True)
@@ -60,8 +61,8 @@ def suite_methods(env_id: str) -> list[str]:
     env = gym.make(env_id)
     scene = env.unwrapped.scene.name
     env.close()
-    return [name for name in baselines.available()
-            if baselines.controller_class(name).made_for(env_id, scene)]
+    return [name for name in homing_baselines.available()
+            if homing_baselines.controller_class(name).made_for(env_id, scene)]
 
 
 def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: int = 0,
@@ -71,7 +72,7 @@ def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: in
     policies = {name: p for name, p in shipped_policies().items()
                 if p.env_id in (None, env_id)}
     made_for = suite_methods(env_id)
-    candidates = baselines.available() + sorted(policies)
+    candidates = homing_baselines.available() + sorted(policies)
     chosen = methods or made_for + sorted(policies)
     unknown = sorted(set(chosen) - set(candidates))
     if unknown:

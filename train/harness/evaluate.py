@@ -2,9 +2,9 @@
 
 Episode ``i`` of a suite with seed ``S`` is ``env.reset(seed=S + i)``, so every method sees
 the same scenes, homes and starts. Policies see only the observation; the harness alone
-reads ``info`` and the env's ground truth to compute the metrics of :mod:`train.metrics`.
+reads ``info`` and the env's ground truth to compute the metrics of :mod:`homing_train.harness.metrics`.
 
-Command line (also ``python -m train.evaluate``)::
+Command line (also ``python -m homing_train.harness.evaluate``)::
 
     homing-eval --policy oracle --env homing_gym/LocalHoming-v0 --episodes 200 --seed 0 \
         --workers 2 --out results/oracle.json
@@ -29,11 +29,11 @@ import numpy as np
 from tqdm import tqdm
 
 import homing_gym
-from baselines.motion import MotionSpec
+from homing_baselines.motion import MotionSpec
 from homing_gym.paths import NoPathError, path_length, shortest_path
 from homing_gym.geometry import wrap_angle
-from train import metrics
-from train.policies import PolicySpec, parse_params, policy_spec
+from homing_train.harness import metrics
+from homing_train.harness.policies import PolicySpec, parse_params, policy_spec
 
 SCHEMA = 1
 DEFAULT_ENV = "homing_gym/LocalHoming-v0"

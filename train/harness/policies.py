@@ -16,8 +16,8 @@ from typing import Any
 import numpy as np
 from gymnasium import spaces
 
-import baselines
-from baselines import Controller
+import homing_baselines
+from homing_baselines import Controller
 
 SB3_PARAMS: dict[str, Any] = {"deterministic": True}   # parameters of SB3 models, defaults
 
@@ -45,7 +45,7 @@ class PolicySpec:
             return SB3Policy(self.source, **self.params)
         if self.instance is not None:
             return dataclasses.replace(self.instance)
-        return baselines.make(self.source, **self.params)
+        return homing_baselines.make(self.source, **self.params)
 
     def resolved_params(self) -> dict[str, Any]:
         """All parameter values of a controller (defaults included); the path for SB3."""
@@ -69,8 +69,8 @@ def policy_spec(policy: str | Controller | PolicySpec,
     if not isinstance(policy, str):
         raise ValueError(f"policy must be a controller name, a controller or a model zip "
                          f"path, got {policy!r}")
-    if policy in baselines.available():
-        baselines.make(policy, **params)  # validates the parameters now
+    if policy in homing_baselines.available():
+        homing_baselines.make(policy, **params)  # validates the parameters now
         return PolicySpec("controller", policy, params)
     if policy.endswith(".zip") or os.path.exists(policy):
         if not os.path.isfile(policy):
@@ -84,7 +84,7 @@ def policy_spec(policy: str | Controller | PolicySpec,
                              f"{params['deterministic']!r}")
         return PolicySpec("sb3", policy, params)
     raise ValueError(f"unknown policy {policy!r}: not a registered controller "
-                     f"{baselines.available()} nor a stable-baselines3 model .zip file")
+                     f"{homing_baselines.available()} nor a stable-baselines3 model .zip file")
 
 
 def _coerce(text: str, default: Any, key: str) -> Any:
@@ -113,13 +113,13 @@ def parse_params(items: list[str] | None, controller: str) -> dict[str, Any]:
     name, or an SB3 model path: then only :data:`SB3_PARAMS`)."""
     if not items:
         return {}
-    if controller in baselines.available():
-        defaults = baselines.parameters(controller)
+    if controller in homing_baselines.available():
+        defaults = homing_baselines.parameters(controller)
     elif controller.endswith(".zip"):
         defaults = SB3_PARAMS
     else:
         raise ValueError("--param applies to registered controllers "
-                         f"{baselines.available()} and SB3 model .zip files")
+                         f"{homing_baselines.available()} and SB3 model .zip files")
     out: dict[str, Any] = {}
     for item in items:
         key, sep, value = item.partition("=")

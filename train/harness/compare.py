@@ -1,6 +1,6 @@
 """Compare evaluation results: a Markdown table with CIs and PNG plots.
 
-Command line (also ``python -m train.compare``)::
+Command line (also ``python -m homing_train.harness.compare``)::
 
     homing-compare results/oracle.json results/random.json --out comparison/
 
@@ -26,7 +26,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from homing_gym.topdown import HOME, MapCanvas, draw_pose, draw_scene  # noqa: E402
-from train.evaluate import EvalResult  # noqa: E402
+from homing_train.harness.evaluate import EvalResult  # noqa: E402
 
 COLORS = plt.get_cmap("tab10").colors
 

@@ -11,7 +11,7 @@ that take one) is drawn as an arrow. Scores:
 * return ratio: share of grid starts from which the controller, run to the end of the
   episode, reaches home (arrow colour: green returned, red did not).
 
-Command line (also ``python -m train.field``)::
+Command line (also ``python -m homing_train.harness.field``)::
 
     homing-field --policy oracle --env homing_gym/LocalHoming-v0 --grid 0.2 --out field.png
 """
@@ -37,9 +37,9 @@ import numpy as np  # noqa: E402
 from homing_gym.geometry import wrap_angle  # noqa: E402
 from homing_gym.scenes.base import clearance  # noqa: E402
 from homing_gym.topdown import HOME, MapCanvas, draw_pose, draw_scene  # noqa: E402
-from train.evaluate import (DEFAULT_ENV, add_policy_arguments, parse_json_kwargs,  # noqa: E402
+from homing_train.harness.evaluate import (DEFAULT_ENV, add_policy_arguments, parse_json_kwargs,  # noqa: E402
                             policy_from_args, prepare_policy, run_episodes)
-from train.policies import PolicySpec, policy_spec  # noqa: E402
+from homing_train.harness.policies import PolicySpec, policy_spec  # noqa: E402
 
 RETURNED, FAILED, UNKNOWN = (40, 160, 60), (210, 50, 40), (40, 90, 200)
 

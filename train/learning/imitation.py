@@ -4,7 +4,7 @@ PPO from pixels alone needs millions of steps to find home often enough to learn
 on 2 CPU cores a run gets a few hundred thousand. ``homing-train --hp
 imitation_iterations=N`` therefore first fits the PPO policy's action distribution to the
 ``oracle`` controller's actions (it drives the true shortest path; see
-:mod:`baselines.oracle`) with DAgger (Ross, Gordon & Bagnell 2011): iteration ``i`` runs
+:mod:`homing_baselines.oracle`) with DAgger (Ross, Gordon & Bagnell 2011): iteration ``i`` runs
 ``imitation_episodes`` episodes in which each step executes the oracle's action with
 probability ``beta = 0.5 ** i`` and the policy's own sampled action otherwise, labels
 *every* visited state with the oracle's action, adds the pairs to the data set and refits
@@ -26,8 +26,8 @@ import gymnasium as gym
 import numpy as np
 from tqdm.auto import tqdm
 
-import baselines
-from train.evaluate import prepare_policy
+import homing_baselines
+from homing_train.harness.evaluate import prepare_policy
 
 
 @dataclass
@@ -111,7 +111,7 @@ def dagger(model, env_id: str, env_kwargs: dict, iterations: int, episodes: int,
         raise ValueError(f"imitation needs iterations, episodes and epochs >= 1, got "
                          f"{iterations}, {episodes}, {epochs}")
     env = gym.make(env_id, **env_kwargs)
-    oracle = baselines.make("oracle")
+    oracle = homing_baselines.make("oracle")
     prepare_policy(oracle, env)
     rng = np.random.default_rng(seed)
     result = ImitationResult()

@@ -1,6 +1,6 @@
 """Ship a trained run: copy its model into ``train/shipped/`` with its settings and curve.
 
-    python -m train.ship runs/ppo_local --name ppo_local [--model best|final|pretrain|imitation]
+    python -m homing_train.learning.ship runs/ppo_local --name ppo_local [--model best|final|pretrain|imitation]
 
 writes ``train/shipped/<name>.zip`` (by default the run's ``best_model.zip``, chosen by
 the evaluation callback on held-out training seeds; ``--model final|pretrain|imitation``
@@ -21,7 +21,7 @@ from pathlib import Path
 
 import yaml
 
-from train.suite import POLICY_DIR
+from homing_train.harness.suite import POLICY_DIR
 
 MAX_BYTES = 10 * 2**20
 #: ``--model`` choices: the run folder's model files.
@@ -81,7 +81,7 @@ def ship_run(run: Path, name: str, folder: Path = POLICY_DIR, model: str = "best
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m train.ship", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m homing_train.learning.ship", description=__doc__.split("\n")[0])
     parser.add_argument("run", type=Path, help="run folder written by homing-train")
     parser.add_argument("--name", required=True, help="name of the shipped policy")
     parser.add_argument("--model", choices=list(MODELS), default="best",
