@@ -19,7 +19,9 @@ from gymnasium import spaces
 import homing_baselines
 from homing_baselines import Controller
 
-SB3_PARAMS: dict[str, Any] = {"deterministic": True}   # parameters of SB3 models, defaults
+#: Parameters of SB3 models and their defaults; ``trust=True`` unpickles the zip (runs code
+#: from the file, see :mod:`homing_train.learning.policy_zip`).
+SB3_PARAMS: dict[str, Any] = {"deterministic": True, "trust": False}
 
 
 @dataclass
@@ -50,8 +52,7 @@ class PolicySpec:
     def resolved_params(self) -> dict[str, Any]:
         """All parameter values of a controller (defaults included); the path for SB3."""
         if self.kind == "sb3":
-            return {"path": os.path.abspath(self.source),
-                    "deterministic": self.params.get("deterministic", True)}
+            return {"path": os.path.abspath(self.source), **SB3_PARAMS, **self.params}
         return (self.instance if self.instance is not None else self.build()).params()
 
 
@@ -79,9 +80,9 @@ def policy_spec(policy: str | Controller | PolicySpec,
         if unknown:
             raise ValueError(f"SB3 models take the parameters {list(SB3_PARAMS)}, "
                              f"not {unknown}")
-        if not isinstance(params.get("deterministic", True), bool):
-            raise ValueError(f"deterministic must be true or false, got "
-                             f"{params['deterministic']!r}")
+        for key in SB3_PARAMS:
+            if not isinstance(params.get(key, SB3_PARAMS[key]), bool):
+                raise ValueError(f"{key} must be true or false, got {params[key]!r}")
         return PolicySpec("sb3", policy, params)
     raise ValueError(f"unknown policy {policy!r}: not a registered controller "
                      f"{homing_baselines.available()} nor a stable-baselines3 model .zip file")
@@ -148,20 +149,24 @@ def _spaces_match(model_space, env_space) -> bool:
 class SB3Policy:
     """A stable-baselines3 PPO model behind the harness' policy interface.
 
+    The zip is read without unpickling unless ``trust=True``
+    (:mod:`homing_train.learning.policy_zip`).
     ``deterministic=True`` (default) acts with the mode of the action distribution;
     ``False`` samples from it, with torch's generator seeded by the episode seed at each
     :meth:`reset`, so a stochastic evaluation is reproducible episode by episode, whichever
     worker runs it."""
 
-    def __init__(self, path: str, deterministic: bool = True):
+    def __init__(self, path: str, deterministic: bool = True, trust: bool = False):
         import torch
-        from stable_baselines3 import PPO  # heavy import: only when a model is evaluated
+
+        # heavy imports: only when a model is evaluated
+        from homing_train.learning.policy_zip import load_policy
 
         # one observation at a time: a thread pool only spins against the other workers
         torch.set_num_threads(1)
         self.path = path
         self.deterministic = bool(deterministic)
-        self.model = PPO.load(path, device="cpu")
+        self.model = load_policy(path, trust=trust)
 
     def check_env(self, env) -> None:
         """``ValueError`` if the model was trained on other observation or action spaces."""

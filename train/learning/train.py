@@ -257,9 +257,9 @@ def set_actor_trainable(policy, trainable: bool) -> None:
 def load_policy_weights(model, path: str | Path) -> None:
     """Copy the policy network (extractor, actor and critic) of the PPO model saved at
     ``path`` into ``model``; the two networks must have the same layout."""
-    from stable_baselines3 import PPO
+    from homing_train.learning.policy_zip import load_policy
 
-    source = PPO.load(path, device=model.device)
+    source = load_policy(path)
     try:
         model.policy.load_state_dict(source.policy.state_dict())
     except RuntimeError as err:
