@@ -22,6 +22,7 @@ import warnings
 import pybullet as p
 from pybullet_utils.bullet_client import BulletClient
 
+from homing_gym.native_output import native_output_captured
 from homing_gym.robot import Robot, RobotConfig
 from homing_gym.scenes.base import Landmark, Scene, Wall
 from homing_gym.textures import texture_path
@@ -34,7 +35,8 @@ class Simulator:
 
     def __init__(self, scene: Scene, *, gui: bool = False, time_step: float = 1 / 240,
                  robot_config: RobotConfig = RobotConfig(), renderer: str = "tiny"):
-        self.client = BulletClient(connection_mode=p.GUI if gui else p.DIRECT)
+        with native_output_captured():    # the C++ core prints "argv[0]=" on connecting
+            self.client = BulletClient(connection_mode=p.GUI if gui else p.DIRECT)
         self._connected = True
         c = self.client
         # the EGL plugin only sees bodies created after it is loaded: load it first
