@@ -53,6 +53,7 @@ from homing_baselines.bearing_laws import (LAWS, LawResult, UnifiedConfig, Unifi
                                     complementary_law, snapshots_similar)
 from homing_baselines.blobs import LAB_COLORS, BlobColor, detect_blobs, matched_bearings
 from homing_baselines.motion import Move
+from homing_gym.validation import require_positive
 
 #: Landmark colours a controller may use, by name.
 PALETTE: dict[str, BlobColor] = {c.name: c for c in LAB_COLORS}
@@ -81,8 +82,7 @@ class BearingLawController(Controller):
             raise ValueError(f"step_length must be at most 1 metre, got {self.step_length!r}")
         for name in ("gain", "stop_tol"):
             value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0):
-                raise ValueError(f"{name} must be a positive number, got {value!r}")
+            require_positive(name, value)
 
     def unified_config(self) -> UnifiedConfig:
         """Algorithm 1's settings at this controller's step length (module docstring)."""

@@ -21,6 +21,8 @@ from typing import Callable, Literal
 
 import numpy as np
 
+from homing_gym.validation import require_positive
+
 from homing_baselines.bearing_laws import (DEFAULT_STOP_TOL, LAWS, UnifiedBatch, UnifiedConfig,
                                     motion_vectors, snapshots_similar)
 
@@ -41,8 +43,7 @@ class SimConfig:
     def __post_init__(self) -> None:
         for name in ("step", "stop_tol", "success_radius"):
             value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0):
-                raise ValueError(f"SimConfig.{name} must be finite and > 0, got {value!r}")
+            require_positive(f"SimConfig.{name}", value)
         if int(self.max_steps) != self.max_steps or self.max_steps < 1:
             raise ValueError(f"SimConfig.max_steps must be a positive integer, got {self.max_steps!r}")
 

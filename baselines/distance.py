@@ -60,6 +60,7 @@ from homing_baselines.base import Controller
 from homing_baselines.landmarks_red import Arc, RedSegmentation, detect_landmarks
 from homing_baselines.motion import Move, integrate
 from homing_gym.geometry import wrap_angle
+from homing_gym.validation import require_positive
 
 ASSIGNMENT_MODES = ("cyclic", "all")
 
@@ -539,9 +540,7 @@ class DistanceController(Controller):
         for key in ("step_length", "move_length", "settle_length", "arrive_tolerance",
                     "nest_step", "clearance", "landmark_radius"):
             value = getattr(self, key)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-                raise ValueError(f"distance: {key} must be a positive number of metres, "
-                                 f"got {value!r}")
+            require_positive(f"distance: {key}", value, "metres")
         if not (isinstance(self.settle_moves, int) and self.settle_moves >= 0):
             raise ValueError(f"distance: settle_moves must be an integer >= 0, "
                              f"got {self.settle_moves!r}")

@@ -38,9 +38,10 @@ from homing_baselines.base import Controller
 from homing_baselines.motion import MotionSpec, Move
 from homing_baselines.multires_localise import LocaliseConfig, localise
 from homing_baselines.multires_matching import arrival_scores, front_view, locate_on_path
+from homing_gym import TAUGHT_KEYS
 from homing_gym.geometry import to_frame
-from homing_gym.tasks.work_locations import TAUGHT_KEYS
 from homing_gym.teaching import FeatureMap, grey, low_resolution
+from homing_gym.validation import require_positive
 
 TRAVEL, ARRIVE, LOCALISE = "travel", "arrive", "localise"
 
@@ -73,8 +74,7 @@ class MultiResController(Controller):
             raise ValueError(f"front_fov_deg must be in [5, 180] degrees, got {self.front_fov_deg!r}")
         for name in ("step_length", "arrival_step", "stop_tolerance", "camera_height"):
             value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-                raise ValueError(f"{name} must be a positive number of metres, got {value!r}")
+            require_positive(name, value, "metres")
         if 1.0 not in self.scales or not all(0.5 <= s <= 2 for s in self.scales):
             raise ValueError(f"scales must lie in [0.5, 2] and include 1, got {self.scales!r}")
         for name in ("max_arrival_moves", "max_corrections"):

@@ -20,6 +20,7 @@ from homing_baselines.motion import Move
 from homing_gym.paths import NoPathError, segment_free, shortest_path
 from homing_gym.geometry import bearing_to, wrap_angle
 from homing_gym.scenes.base import clearance
+from homing_gym.validation import require_positive
 
 
 @dataclass
@@ -40,8 +41,7 @@ class OracleController(Controller):
     def validate(self) -> None:
         for key in ("step_length", "arrive_tolerance", "heading_tolerance", "margin"):
             value = getattr(self, key)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-                raise ValueError(f"oracle: {key} must be a positive number, got {value!r}")
+            require_positive(f"oracle: {key}", value)
 
     def attach_env(self, env) -> None:
         """Give the oracle its privileged handle on the (unwrapped) env."""

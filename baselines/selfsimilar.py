@@ -99,6 +99,7 @@ from homing_baselines.selfsimilar_detector import Detection, DetectorConfig, det
 from homing_baselines.selfsimilar_graph import VisibilityGraph
 from homing_baselines.selfsimilar_panel import panel_pose
 from homing_gym.geometry import wrap_angle
+from homing_gym.validation import require_positive
 
 PLANNING = ("deterministic", "probabilistic")
 #: Times the robot servos again at the goal when the episode did not end.
@@ -175,9 +176,7 @@ class SelfSimilarController(Controller):
         for name in ("view_hfov_deg", "standoff", "step_length", "far", "look_cost",
                      "wander_distance"):
             value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-                raise ValueError(f"selfsimilar: {name} must be a positive number, "
-                                 f"got {value!r}")
+            require_positive(f"selfsimilar: {name}", value)
         if not self.view_hfov_deg < 180:
             raise ValueError(f"selfsimilar: view_hfov_deg must be below 180 degrees, "
                              f"got {self.view_hfov_deg!r}")

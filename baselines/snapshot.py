@@ -51,8 +51,9 @@ from homing_baselines.base import Controller
 from homing_baselines.motion import Move, integrate
 from homing_baselines.signature import (CharacteristicPoints, characteristic_points,
                                  signature_from_omni, signature_from_panorama)
+from homing_gym import FOOT
 from homing_gym.geometry import wrap_angle
-from homing_gym.tasks.route_following import FOOT
+from homing_gym.validation import require_positive
 
 SOURCES = ("panorama", "omni")
 TARGET_STATS = ("candidate", "centre")
@@ -415,9 +416,7 @@ class SnapshotController(Controller):
                              f"allowed: {INITIAL_DEVIATION}")
         for key in ("first_step_ft", "second_step_ft", "later_step_ft"):
             value = getattr(self, key)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-                raise ValueError(f"snapshot: {key} must be a positive number of feet, "
-                                 f"got {value!r}")
+            require_positive(f"snapshot: {key}", value, "feet")
         if not (0 < self.stop_angle <= 180):
             raise ValueError(f"snapshot: stop_angle must be in (0, 180] degrees, "
                              f"got {self.stop_angle!r}")

@@ -17,22 +17,26 @@ import numpy as np
 from gymnasium import spaces
 
 from homing_gym.geometry import to_frame
+from homing_gym.observations import CORE_KEYS, ObservationKey, Sight, goal_step_key
 from homing_gym.panorama import CameraConfig, Lighting, PanoramaCamera, random_lighting
 from homing_gym.perspective import PerspectiveConfig, render_perspective
 from homing_gym.robot import RobotConfig, WheelOdometry
 from homing_gym.scenes import scene_factory
 from homing_gym.scenes.base import Scene
 from homing_gym.simulator import Simulator
-from homing_gym.tasks.base import Episode, Task
+from homing_gym.tasks.base import Task
+from homing_gym.tasks.context import TaskContext
+from homing_gym.tasks.episode import Episode
 from homing_gym.topdown import compose_frame, draw_topdown
+from homing_gym.validation import require_positive
 
 ACTION_TYPES = ("continuous", "discrete")
 #: Discrete actions: index -> (forward, yaw) in normalised units.
 DISCRETE_ACTIONS = {0: (1.0, 0.0), 1: (0.0, 1.0), 2: (0.0, -1.0), 3: (0.0, 0.0)}
 DISCRETE_NAMES = ("forward", "turn_left", "turn_right", "stop")
-#: Observation keys the env core provides (tasks may add more).
-OBSERVATION_KEYS = ("panorama", "goal", "omni", "goal_omni", "signature", "goal_signature",
-                    "goal_step", "odometry")
+#: Observation keys the env core provides (tasks may add more): see
+#: :mod:`homing_gym.observations`.
+OBSERVATION_KEYS = (*CORE_KEYS, "goal_step")
 
 
 class HomingEnv(gym.Env):
@@ -63,19 +67,17 @@ class HomingEnv(gym.Env):
             raise ValueError(f"unknown action_type {action_type!r}; allowed: {ACTION_TYPES}")
         if not (isinstance(physics_substeps, (int, np.integer)) and physics_substeps >= 1):
             raise ValueError(f"physics_substeps must be an integer >= 1, got {physics_substeps!r}")
-        if not (math.isfinite(control_period) and control_period > 0):
-            raise ValueError(f"control_period must be positive seconds, got {control_period!r}")
-        for name, value in (("max_speed", max_speed), ("max_yaw_rate", max_yaw_rate)):
-            if not (math.isfinite(value) and value > 0):
-                raise ValueError(f"{name} must be a positive number, got {value!r}")
+        require_positive("control_period", control_period, "seconds")
+        require_positive("max_speed", max_speed, "m/s")
+        require_positive("max_yaw_rate", max_yaw_rate, "rad/s")
         if not (0 <= lighting_change <= 1):
             raise ValueError(f"lighting_change must be in [0, 1] (0: off), got {lighting_change!r}")
-        if not (math.isfinite(goal_step_length) and 0 < goal_step_length <= 1):
-            raise ValueError(f"goal_step_length must be in (0, 1] metres, got {goal_step_length!r}")
         if not (0 <= stop_threshold < 1):
             raise ValueError(f"stop_threshold must be in [0, 1), got {stop_threshold!r}")
-        task_keys = task.extra_spaces()
-        allowed = OBSERVATION_KEYS + tuple(task_keys)
+        table: dict[str, ObservationKey] = {**CORE_KEYS,
+                                            "goal_step": goal_step_key(goal_step_length),
+                                            **task.observation_keys()}
+        allowed = tuple(table)
         unknown = [k for k in obs_keys if k not in allowed]
         if unknown or len(obs_keys) == 0 or len(set(obs_keys)) != len(obs_keys):
             raise ValueError(f"bad obs_keys {tuple(obs_keys)!r}: give distinct keys from {allowed}")
@@ -105,17 +107,9 @@ class HomingEnv(gym.Env):
         self.camera = PanoramaCamera(camera_config, self.robot_config.camera_height,
                                      renderer=self.sim.renderer)
 
-        H, W = self.camera.config.panorama_shape
-        S = self.camera.config.omni_size
-        image = spaces.Box(0, 255, (H, W, 3), np.uint8)
-        ring = spaces.Box(0, 255, (S, S, 3), np.uint8)
-        signature = spaces.Box(0.0, 1.0, (W,), np.float32)
-        core = {"panorama": image, "goal": image, "goal_step": image, "omni": ring,
-                "goal_omni": ring,
-                "signature": signature, "goal_signature": signature,
-                "odometry": spaces.Box(-np.inf, np.inf, (3,), np.float32)}
-        core.update(task_keys)
-        self.observation_space = spaces.Dict({k: core[k] for k in self.obs_keys})
+        self._table = {k: table[k] for k in self.obs_keys}
+        self.observation_space = spaces.Dict(
+            {k: entry.space(self.camera.config) for k, entry in self._table.items()})
         if action_type == "discrete":
             self.action_space = spaces.Discrete(len(DISCRETE_ACTIONS))
         else:
@@ -131,6 +125,15 @@ class HomingEnv(gym.Env):
         self.goal_index = 0
         self._goal_views: list[dict[str, np.ndarray]] = []
         self._goal_obs: dict[str, np.ndarray] = {}
+        self._start_pose = np.zeros(3)
+        self._task_context = TaskContext(
+            pose=lambda: self.pose, distance_to_goal=lambda: self.distance_to_goal,
+            goal_index=lambda: self.goal_index, episode=lambda: self.episode,
+            scene=lambda: self.scene, rng=lambda: self.np_random, obs_keys=self.obs_keys,
+            robot=self.robot_config, camera=self.camera.config,
+            place_robot=self._place_robot, snapshot=self._snapshot_panorama,
+            ray_hit=self.sim.ray_hit, use_world=self.sim.reset_world,
+            advance_goal=self.advance_goal)
 
     # -- helpers --------------------------------------------------------------------------
     @property
@@ -185,24 +188,36 @@ class HomingEnv(gym.Env):
         self.goal_index += 1
         self._goal_obs = self._goal_views[self.goal_index]
 
-    def _snapshot(self, pose: np.ndarray) -> dict[str, np.ndarray]:
-        """Goal observations of a snapshot taken with the robot standing at ``pose``
-        (rendered with the scene's snapshot-time lighting); ``goal_step`` is a second
-        snapshot ``goal_step_length`` metres straight ahead of ``pose`` (Yu & Kim §II-A
-        measure their nest map from two snapshots one step apart)."""
+    def _snapshot_panorama(self, pose) -> np.ndarray:
+        """The panorama taken with the robot standing at ``pose`` under snapshot-time
+        lighting (the robot stays there)."""
         self.sim.robot.set_pose(*pose)
-        goal = self.camera.render(self.sim.client, pose)
-        views = {"goal": goal}
-        if "goal_step" in self.obs_keys:
-            d = self.goal_step_length
-            ahead = np.array([pose[0] + d * math.cos(pose[2]), pose[1] + d * math.sin(pose[2]),
-                              pose[2]])
-            self.sim.robot.set_pose(*ahead)
-            views["goal_step"] = self.camera.render(self.sim.client, ahead)
-        if "goal_omni" in self.obs_keys:
-            views["goal_omni"] = self.camera.omni(goal)
-        if "goal_signature" in self.obs_keys:
-            views["goal_signature"] = self.camera.signature(goal)
+        return self.camera.render(self.sim.client, pose)
+
+    def _place_robot(self, pose, clear_contacts: bool = False) -> None:
+        """Teleport the robot to ``pose`` and restart odometry there, in home's frame."""
+        self.sim.place_robot(pose, clear_contacts)
+        self.pose = self.sim.robot.pose()
+        self.odometry.reset(to_frame(self.episode.home, self.pose),
+                            self.sim.robot.wheel_angles())
+
+    def _goal_sight(self, pose: np.ndarray) -> Sight:
+        """The snapshot of a goal: its panorama is taken now, with the robot standing at
+        ``pose``; ``panorama_ahead(d)`` renders ``d`` metres straight ahead of it."""
+        def ahead(d: float) -> np.ndarray:
+            return self._snapshot_panorama(np.array(
+                [pose[0] + d * math.cos(pose[2]), pose[1] + d * math.sin(pose[2]), pose[2]]))
+
+        panorama = self._snapshot_panorama(pose)
+        return Sight(self.camera, lambda: panorama, ahead=ahead)
+
+    def _snapshot(self, pose: np.ndarray) -> dict[str, np.ndarray]:
+        """The goal observation keys of a snapshot taken at ``pose`` (``goal`` always:
+        the ``rgb_array`` picture shows it)."""
+        sight = self._goal_sight(pose)
+        views = {"goal": sight.panorama}
+        views.update({k: entry.produce(sight) for k, entry in self._table.items()
+                      if entry.goal and k != "goal"})
         return views
 
     def _command(self, action) -> tuple[float, float, bool]:
@@ -224,25 +239,18 @@ class HomingEnv(gym.Env):
         return float(v), float(w), bool(stop)
 
     def _observation(self, skip_images: bool = False) -> dict[str, np.ndarray]:
-        if skip_images and self._last_obs:
-            obs = {k: v.copy() for k, v in self._last_obs.items()}
-            if "odometry" in self.obs_keys:
-                obs["odometry"] = self.odometry.estimate.astype(np.float32)
-            return obs
+        """The observation of the current step from the table; after
+        :meth:`skip_next_images`, the rendered keys repeat their last value."""
+        sight = Sight(self.camera, lambda: self.panorama, odometry=lambda: self.odometry.estimate,
+                      view=lambda size, hfov: self.render_view(size=size, hfov_deg=hfov))
         obs: dict[str, np.ndarray] = {}
-        for key in self.obs_keys:
-            if key == "panorama":
-                obs[key] = self.panorama.copy()
-            elif key == "omni":
-                obs[key] = self.camera.omni(self.panorama)
-            elif key == "signature":
-                obs[key] = self.camera.signature(self.panorama)
-            elif key == "odometry":
-                obs[key] = self.odometry.estimate.astype(np.float32)
-            elif key in self._goal_obs:
+        for key, entry in self._table.items():
+            if entry.goal:
                 obs[key] = self._goal_obs[key].copy()
-        obs.update({k: v for k, v in self.task.extra_observation(self).items()
-                    if k in self.obs_keys})
+            elif skip_images and entry.rendered and key in self._last_obs:
+                obs[key] = self._last_obs[key].copy()
+            else:
+                obs[key] = entry.produce(sight)
         self._last_obs = obs
         return obs
 
@@ -268,12 +276,14 @@ class HomingEnv(gym.Env):
         return {
             "pose": self.pose.copy(),
             "goal_pose": self.goal_pose.copy(),
+            "home_pose": np.array(self.episode.home, dtype=np.float64),
+            "start_pose": self._start_pose.copy(),
             "distance_to_goal": self.distance_to_goal,
             "is_success": bool(success),
             "collision": bool(collision),
             "collisions": self.collisions,
             "rewards": rewards or {},
-            **self.task.extra_info(self),
+            **self.task.extra_info(self._task_context),
         }
 
     # -- Gymnasium API --------------------------------------------------------------------
@@ -289,22 +299,20 @@ class HomingEnv(gym.Env):
         self._goal_obs = self._goal_views[0]
         self._lighting = (random_lighting(self.np_random, self.lighting_change)
                           if self.lighting_change > 0 else None)
-        robot = self.sim.robot
-        robot.set_pose(*self.episode.start)
-        self.pose = robot.pose()
-        self.odometry.reset(to_frame(self.episode.home, self.pose), robot.wheel_angles())
+        self._place_robot(self.episode.start, self.task.fresh_contacts)
+        self._start_pose = self.pose.copy()
         self._panorama = None
         self._skip_images = False
         self._last_obs = {}
         self.trajectory = [(float(self.pose[0]), float(self.pose[1]))]
         self.collisions = 0
-        self.task.on_reset(self)
+        self.task.on_reset(self._task_context)
         return self._observation(), self._info()
 
     def step(self, action):
         if self.episode is None:
             raise RuntimeError("call reset() before step()")
-        v, w, stopped = self.task.command(self, *self._command(action))
+        v, w, stopped = self.task.command(self._task_context, *self._command(action))
         robot = self.sim.robot
         robot.drive(v * self.robot_config.max_speed, w * self.robot_config.max_yaw_rate)
         collision = self.sim.step(self.physics_substeps)
@@ -315,7 +323,7 @@ class HomingEnv(gym.Env):
         skip_images, self._skip_images = self._skip_images, False
         self.trajectory.append((float(self.pose[0]), float(self.pose[1])))
         self.collisions += int(collision)
-        rewards, terminated, success = self.task.step_outcome(self, collision, stopped)
+        rewards, terminated, success = self.task.step_outcome(self._task_context, collision, stopped)
         reward = float(sum(rewards.values()))
         if self.render_mode == "human":
             self.render()

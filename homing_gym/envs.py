@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from homing_gym.env import HomingEnv
+from homing_gym.geometry import FOOT
 from homing_gym.scenes import SceneFactory, scene_factory
 from homing_gym.scenes.base import Scene
 from homing_gym.scenes.daily_changes import daily_changes as daily_changes_of
@@ -12,7 +13,6 @@ from homing_gym.scenes.landmark_changes import changed_landmarks
 from homing_gym.tasks import (LocalHomingTask, LongRangeHomingTask, RewardConfig,
                               RouteFollowingTask)
 from homing_gym.tasks.landmark_navigation import LandmarkNavigationTask
-from homing_gym.tasks.route_following import FOOT
 from homing_gym.tasks.work_locations import MAX_POINTS, TAUGHT_KEYS, WorkLocationsTask
 from homing_gym.teaching import PLACE_SPACING
 
@@ -85,9 +85,12 @@ class LocalHomingEnv(HomingEnv):
 
     ## Info
 
-    ``pose`` and ``goal_pose`` (x, y, yaw; metres, radians), ``distance_to_goal`` (m),
+    ``pose`` (the robot's true pose), ``goal_pose`` (the current goal), ``home_pose`` (the
+    episode's home, its last goal) and ``start_pose`` (the robot's pose right after
+    reset), all (x, y, yaw) in metres and radians; ``distance_to_goal`` (m),
     ``is_success``, ``collision`` (contact this step), ``collisions`` (steps with contact
     so far), ``rewards`` (the reward terms). Ground truth: for metrics, not for agents.
+    The scene of the episode is ``env.unwrapped.scene`` (for path-length metrics).
 
     ## Arguments
 

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
+#: One foot in metres (Hong et al. 1991 space their route targets 1 ft apart).
+FOOT = 0.3048
+
 
 def wrap_angle(angle):
     """Wrap an angle (radians, scalar or array) into ``(-pi, pi]``."""

@@ -41,6 +41,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+from homing_gym.validation import require_positive
 
 #: The paper's scale factor (Fig. 3, Fig. 5).
 DEFAULT_P = 2 / 3
@@ -117,9 +118,7 @@ class PanelLayout:
     def __post_init__(self) -> None:
         for name in ("pattern_width", "pattern_height", "gap", "barcode_width", "margin"):
             value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0):
-                raise ValueError(f"PanelLayout.{name} must be a positive number of metres, "
-                                 f"got {value!r}")
+            require_positive(f"PanelLayout.{name}", value, "metres")
 
     @property
     def width(self) -> float:

@@ -19,6 +19,7 @@ import pkgutil
 import tempfile
 import warnings
 
+import numpy as np
 import pybullet as p
 from pybullet_utils.bullet_client import BulletClient
 
@@ -177,6 +178,23 @@ class Simulator:
         self._state = c.saveState()
         self.obstacle_ids = frozenset(self.wall_ids + self.landmark_ids)
         self.scene = scene
+
+    def place_robot(self, pose, clear_contacts: bool = False) -> None:
+        """Teleport the robot to ``pose`` (x, y, yaw; metres, radians). With
+        ``clear_contacts`` it is first sent 100 m away and back, which drops the contact
+        points PyBullet keeps cached by proximity (with their warm-start impulses), so
+        the next steps do not depend on where the robot stood before."""
+        x, y, yaw = (float(v) for v in pose)
+        self.robot.set_pose(x, y, yaw)
+        if clear_contacts:
+            self.robot.set_pose(x + 100.0, y, yaw)
+            self.robot.set_pose(x, y, yaw)
+
+    def ray_hit(self, start, end) -> np.ndarray | None:
+        """The first point (3-D, metres) that the straight ray from ``start`` to ``end``
+        hits, or ``None`` when nothing is in the way."""
+        hit = self.client.rayTest([float(v) for v in start], [float(v) for v in end])[0]
+        return None if hit[0] < 0 else np.asarray(hit[3], dtype=np.float64)
 
     def step(self, substeps: int) -> bool:
         """Advance the physics ``substeps`` times; True if the robot touched an obstacle."""

@@ -26,16 +26,20 @@ with the teaching-time lighting, as the env's goal snapshots are.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import cv2
 import numpy as np
 
 from homing_gym.panorama import LUMA, bearing_column
+from homing_gym.validation import require_positive
 
-if TYPE_CHECKING:
-    from homing_gym.env import HomingEnv
+#: ``snapshot(pose)``: the full-resolution panorama (RGB uint8) taken with the robot
+#: standing at ``pose`` (x, y, yaw) under teaching-time lighting.
+Snapshot = Callable[[np.ndarray], np.ndarray]
+#: ``ray_hit(start, end)``: the first point a straight ray hits (3-D, metres), or None.
+RayHit = Callable[[np.ndarray, np.ndarray], "np.ndarray | None"]
 
 #: Distance (m) between taught places along a path (§4(1)).
 PLACE_SPACING = 0.47
@@ -80,8 +84,7 @@ def path_places(points, spacing: float = PLACE_SPACING) -> np.ndarray:
     pts = np.asarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 2:
         raise ValueError(f"a path needs at least two (x, y) points, got {points!r}")
-    if not (math.isfinite(spacing) and spacing > 0):
-        raise ValueError(f"spacing must be positive metres, got {spacing!r}")
+    require_positive("spacing", spacing, "metres")
     legs = np.diff(pts, axis=0)
     lengths = np.hypot(legs[:, 0], legs[:, 1])
     if np.any(lengths < 1e-9):
@@ -97,19 +100,12 @@ def path_places(points, spacing: float = PLACE_SPACING) -> np.ndarray:
     return np.column_stack([xy, yaw])
 
 
-def teaching_panorama(env: "HomingEnv", pose) -> np.ndarray:
-    """The full-resolution panorama (RGB uint8) taken with the robot standing at
-    ``pose`` under the teaching-time lighting."""
-    env.sim.robot.set_pose(*pose)
-    return env.camera.render(env.sim.client, pose)
-
-
-def teach_path(env: "HomingEnv", points, levels: int,
+def teach_path(snapshot: Snapshot, points, levels: int,
                spacing: float = PLACE_SPACING) -> tuple[np.ndarray, np.ndarray]:
     """Low-resolution panoramas ``(K, h, w)`` uint8 at the places of :func:`path_places`,
     each centred on the desired direction of travel, and the places ``(K, 3)``."""
     places = path_places(points, spacing)
-    images = np.stack([low_resolution(teaching_panorama(env, pose), levels)
+    images = np.stack([low_resolution(snapshot(pose), levels)
                        for pose in places])
     return images, places
 
@@ -152,25 +148,26 @@ def clip_template(image: np.ndarray, x: float, y: float, size: int) -> np.ndarra
     return cv2.getRectSubPix(padded, (size, size), (x - 0.5 + pad, y - 0.5))
 
 
-def teach_work_location(env: "HomingEnv", pose, feature_points: dict, levels: int,
+def teach_work_location(snapshot: Snapshot, ray_hit: RayHit, camera_height: float,
+                        vfov: float, pose, feature_points: dict, levels: int,
                         template_size: int = 17, max_points: int = 10,
                         distance_range: tuple[float, float] = (0.8, 6.0)) -> FeatureMap:
     """The feature map of the work location ``pose``: up to ``max_points`` of the scene's
     ``feature_points`` (``{name: (x, y, z)}``) that lie ``distance_range`` metres away,
     are unoccluded (a ray from the camera reaches them) and whose template lies inside
     the panorama's rows; chosen greedily to spread around the horizon (each next point
-    the one farthest in bearing from those chosen)."""
-    pano = teaching_panorama(env, pose)
+    the one farthest in bearing from those chosen). ``snapshot`` and ``ray_hit`` see the
+    taught world (:data:`Snapshot`, :data:`RayHit`); ``camera_height`` in metres, ``vfov``
+    the panorama's vertical field of view in radians."""
+    pano = snapshot(pose)
     H, W = pano.shape[:2]
-    vfov = env.camera.config.vfov
-    cam = env.robot_config.camera_height
     half = (template_size // 2 + 1) * vfov / H
     candidates = []
     for name in sorted(feature_points):
         point = feature_points[name]
-        bearing, elevation, dist = point_direction(pose, point, cam)
+        bearing, elevation, dist = point_direction(pose, point, camera_height)
         if not (distance_range[0] <= dist <= distance_range[1]
-                and abs(elevation) + half < vfov / 2 and _visible(env, pose, point, cam)):
+                and abs(elevation) + half < vfov / 2 and _visible(ray_hit, pose, point, camera_height)):
             continue
         candidates.append((bearing, elevation, point))
     chosen: list[tuple[float, float, tuple]] = []
@@ -197,14 +194,12 @@ def teach_work_location(env: "HomingEnv", pose, feature_points: dict, levels: in
         pose=np.asarray(pose, np.float32), levels=levels)
 
 
-def _visible(env: "HomingEnv", pose, point, camera_height: float) -> bool:
+def _visible(ray_hit: RayHit, pose, point, camera_height: float) -> bool:
     """Whether the straight line from the camera to ``point`` is free (the ray starts
     outside the robot body and may end within 3 cm of the point: the surface it is on)."""
     eye = np.array([pose[0], pose[1], camera_height])
     target = np.asarray(point, dtype=np.float64)
     length = float(np.linalg.norm(target - eye))
     start = eye + (target - eye) * (0.2 / length)
-    hit = env.sim.client.rayTest(start.tolist(), target.tolist())[0]
-    if hit[0] < 0:
-        return True
-    return float(np.linalg.norm(np.asarray(hit[3]) - target)) < 0.03
+    hit = ray_hit(start, target)
+    return hit is None or float(np.linalg.norm(hit - target)) < 0.03

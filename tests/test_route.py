@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from homing_gym.scenes import Scene, square_walls
-from homing_gym.tasks.route_following import FOOT
+from homing_gym import FOOT
 
 ROUTE = "homing_gym/RouteFollowing-v0"
 FORWARD = np.array([1.0, 0.0], np.float32)

@@ -15,6 +15,7 @@ from functools import lru_cache
 import numpy as np
 
 from homing_gym.textures import check_texture
+from homing_gym.validation import require_positive
 
 SHAPES = ("cylinder", "box", "panel")
 
@@ -22,8 +23,7 @@ Color = tuple[float, float, float, float]
 
 
 def _check_positive(owner: str, name: str, value: float) -> None:
-    if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-        raise ValueError(f"{owner}: {name} must be a positive number of metres, got {value!r}")
+    require_positive(f"{owner}: {name}", value, "metres")
 
 
 def _check_color(owner: str, color: Color) -> None:

@@ -1,41 +1,30 @@
 """What a task decides: where an episode starts and ends, what it rewards.
 
 The env core (:mod:`homing_gym.env`) owns the simulator, robot and camera; a
-:class:`Task` owns the episode logic. New tasks subclass :class:`Task`; they may add
-observation keys through :meth:`Task.extra_spaces` and :meth:`Task.extra_observation`.
+:class:`Task` owns the episode logic and reaches the env only through a
+:class:`~homing_gym.tasks.context.TaskContext`. New tasks subclass :class:`Task`; they may
+add observation keys through :meth:`Task.observation_keys`.
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import ClassVar
 
 import numpy as np
-from gymnasium import spaces
 
+from homing_gym.observations import ObservationKey
 from homing_gym.scenes.base import Scene, clearance
-
-if TYPE_CHECKING:
-    from homing_gym.env import HomingEnv
-
-
-@dataclass(frozen=True)
-class Episode:
-    """The poses ``(x, y, yaw)`` (metres, radians CCW) of one episode: the start, and the
-    goals to reach in order, ``waypoints`` first and ``home`` last."""
-
-    home: np.ndarray
-    start: np.ndarray
-    waypoints: tuple[np.ndarray, ...] = ()
-
-    @property
-    def goals(self) -> tuple[np.ndarray, ...]:
-        return (*self.waypoints, self.home)
+from homing_gym.tasks.context import TaskContext
+from homing_gym.tasks.episode import Episode
 
 
 class Task(ABC):
     """Episode logic plugged into :class:`~homing_gym.env.HomingEnv`."""
+
+    #: Clear PyBullet's cached contacts when the robot is put at the start (episodes that
+    #: may start where the last one ended, see ``LongRangeHomingTask``).
+    fresh_contacts: ClassVar[bool] = False
 
     @abstractmethod
     def sample_episode(self, scene: Scene, rng: np.random.Generator) -> Episode:
@@ -44,10 +33,10 @@ class Task(ABC):
     def check_scene(self, scene: Scene) -> None:
         """Raise ``ValueError`` if the task's settings cannot be met in ``scene``."""
 
-    def on_reset(self, env: "HomingEnv") -> None:
+    def on_reset(self, ctx: TaskContext) -> None:
         """Called at the end of ``env.reset``, once the robot stands at the start."""
 
-    def command(self, env: "HomingEnv", v: float, w: float,
+    def command(self, ctx: TaskContext, v: float, w: float,
                 stopped: bool) -> tuple[float, float, bool]:
         """The command the robot executes this step, from the agent's validated one
         (normalised forward speed ``v``, yaw rate ``w``, stop flag). Default: the agent's;
@@ -55,18 +44,16 @@ class Task(ABC):
         return v, w, stopped
 
     @abstractmethod
-    def step_outcome(self, env: "HomingEnv", collision: bool, stopped: bool) -> tuple[dict, bool, bool]:
+    def step_outcome(self, ctx: TaskContext, collision: bool,
+                     stopped: bool) -> tuple[dict, bool, bool]:
         """After a control step: ``(reward terms, terminated, is_success)``."""
 
-    def extra_spaces(self) -> dict[str, spaces.Space]:
-        """Observation keys this task adds to the env's observation ``Dict``."""
+    def observation_keys(self) -> dict[str, ObservationKey]:
+        """Observation keys this task adds to the env's table
+        (:mod:`homing_gym.observations`)."""
         return {}
 
-    def extra_observation(self, env: "HomingEnv") -> dict[str, np.ndarray]:
-        """Values of the keys of :meth:`extra_spaces` for the current step."""
-        return {}
-
-    def extra_info(self, env: "HomingEnv") -> dict:
+    def extra_info(self, ctx: TaskContext) -> dict:
         """Task-specific entries added to ``info`` at reset and every step."""
         return {}
 

@@ -5,12 +5,11 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, fields
-from typing import TYPE_CHECKING
 
+from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.base import Task
+from homing_gym.validation import require_positive
 
-if TYPE_CHECKING:
-    from homing_gym.env import HomingEnv
 
 SUCCESS_MODES = ("reach", "stop")
 
@@ -65,9 +64,7 @@ class GoalReachingTask(Task):
 
     def __init__(self, success_radius: float = 0.15, success_on: str = "reach",
                  reward: RewardConfig | Mapping[str, float] = RewardConfig()):
-        if not (math.isfinite(success_radius) and success_radius > 0):
-            raise ValueError(f"success_radius must be a positive number of metres, "
-                             f"got {success_radius!r}")
+        require_positive("success_radius", success_radius, "metres")
         if success_on not in SUCCESS_MODES:
             raise ValueError(f"unknown success_on {success_on!r}; allowed: {SUCCESS_MODES}")
         self.success_radius = float(success_radius)
@@ -76,15 +73,15 @@ class GoalReachingTask(Task):
         self.goal_errors: list[float] = []
         self._prev_distance = 0.0
 
-    def on_reset(self, env: "HomingEnv") -> None:
-        self._prev_distance = env.distance_to_goal
+    def on_reset(self, ctx: TaskContext) -> None:
+        self._prev_distance = ctx.distance_to_goal()
         self.goal_errors = []
 
-    def step_outcome(self, env: "HomingEnv", collision: bool, stopped: bool):
-        distance = env.distance_to_goal
+    def step_outcome(self, ctx: TaskContext, collision: bool, stopped: bool):
+        distance = ctx.distance_to_goal()
         within = distance < self.success_radius
         arrived = stopped if self.success_on == "stop" else within
-        last = env.goal_index == len(env.episode.goals) - 1
+        last = ctx.goal_index() == len(ctx.episode().goals) - 1
         rewards = {
             "progress": self.reward.progress * (self._prev_distance - distance),
             "waypoint": 0.0,
@@ -101,6 +98,6 @@ class GoalReachingTask(Task):
                 rewards["success"] = self.reward.success if success else 0.0
             else:
                 rewards["waypoint"] = self.reward.waypoint if within else 0.0
-                env.advance_goal()
-                self._prev_distance = env.distance_to_goal
+                ctx.advance_goal()
+                self._prev_distance = ctx.distance_to_goal()
         return rewards, terminated, success

@@ -19,20 +19,20 @@ out along the normal, facing the panel.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 from gymnasium import spaces
 
 from homing_gym.geometry import bearing_to, wrap_angle
+from homing_gym.observations import ObservationKey, constant_key
 from homing_gym.perspective import PerspectiveConfig
 from homing_gym.scenes.base import Scene, clearance
 from homing_gym.selfsimilar import MAX_ID
+from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.base import Episode, Task
 from homing_gym.tasks.goal_reaching import SUCCESS_MODES, RewardConfig
+from homing_gym.validation import require_positive
 
-if TYPE_CHECKING:
-    from homing_gym.env import HomingEnv
 
 #: Length of the one-hot ``goal_id``: every id a barcode can carry.
 N_IDS = MAX_ID + 1
@@ -55,9 +55,8 @@ class LandmarkNavigationTask(Task):
                  standoff: float = 0.8, success_on: str = "reach",
                  reward: RewardConfig = RewardConfig(), clearance_margin: float = 0.25,
                  view_size: tuple[int, int] = (320, 240), view_hfov_deg: float = 60.0):
-        for name, value in (("max_distance", max_distance), ("standoff", standoff)):
-            if not (math.isfinite(value) and value > 0):
-                raise ValueError(f"{name} must be a positive number of metres, got {value!r}")
+        require_positive("max_distance", max_distance, "metres")
+        require_positive("standoff", standoff, "metres")
         if standoff > max_distance:
             raise ValueError(f"standoff {standoff!r} m must not exceed max_distance "
                              f"{max_distance!r} m")
@@ -116,12 +115,12 @@ class LandmarkNavigationTask(Task):
         return off_normal <= self.max_angle and abs(bearing_to(pose, (x, y))) <= self.max_angle
 
     # -- steps ----------------------------------------------------------------------------------
-    def on_reset(self, env: "HomingEnv") -> None:
-        self._prev_distance = env.distance_to_goal
+    def on_reset(self, ctx: TaskContext) -> None:
+        self._prev_distance = ctx.distance_to_goal()
 
-    def step_outcome(self, env: "HomingEnv", collision: bool, stopped: bool):
-        distance = env.distance_to_goal
-        success = self.in_front(env.scene, env.pose, self.goal_id)
+    def step_outcome(self, ctx: TaskContext, collision: bool, stopped: bool):
+        distance = ctx.distance_to_goal()
+        success = self.in_front(ctx.scene(), ctx.pose(), self.goal_id)
         terminated = stopped if self.success_on == "stop" else success
         success = success and terminated
         rewards = {
@@ -134,20 +133,18 @@ class LandmarkNavigationTask(Task):
         return rewards, terminated, success
 
     # -- observations ---------------------------------------------------------------------------
-    def extra_spaces(self) -> dict[str, spaces.Space]:
+    def observation_keys(self) -> dict[str, ObservationKey]:
         w, h = self.view_size
-        return {"goal_id": spaces.Box(0.0, 1.0, (N_IDS,), np.float32),
-                "view": spaces.Box(0, 255, (h, w, 3), np.uint8)}
+        return {"goal_id": constant_key(spaces.Box(0.0, 1.0, (N_IDS,), np.float32),
+                                        self._goal_one_hot),
+                "view": ObservationKey(
+                    lambda config: spaces.Box(0, 255, (h, w, 3), np.uint8),
+                    lambda sight: sight.view(self.view_size, self.view_hfov_deg))}
 
-    def extra_observation(self, env: "HomingEnv") -> dict[str, np.ndarray]:
-        out = {}
-        if "goal_id" in env.obs_keys:
-            one_hot = np.zeros(N_IDS, np.float32)
-            one_hot[self.goal_id] = 1.0
-            out["goal_id"] = one_hot
-        if "view" in env.obs_keys:
-            out["view"] = env.render_view(size=self.view_size, hfov_deg=self.view_hfov_deg)
-        return out
+    def _goal_one_hot(self) -> np.ndarray:
+        one_hot = np.zeros(N_IDS, np.float32)
+        one_hot[self.goal_id] = 1.0
+        return one_hot
 
-    def extra_info(self, env: "HomingEnv") -> dict:
+    def extra_info(self, ctx: TaskContext) -> dict:
         return {"goal_id": self.goal_id}

@@ -13,19 +13,19 @@ actions are validated and ignored, no reward is paid and the episode cannot end.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 from gymnasium import spaces
 
 from homing_gym.geometry import bearing_to
+from homing_gym.observations import ObservationKey, constant_key
 from homing_gym.robot import RobotConfig
 from homing_gym.scenes.base import Scene, clearance
+from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.base import Episode, sample_free_pose
 from homing_gym.tasks.goal_reaching import GoalReachingTask, RewardConfig
+from homing_gym.validation import require_positive
 
-if TYPE_CHECKING:
-    from homing_gym.env import HomingEnv
 
 OUTBOUND, HOMING = 0, 1
 #: A waypoint counts as passed within this distance (m).
@@ -73,11 +73,16 @@ def plan_route(scene: Scene, start, rng: np.random.Generator, length: float,
 
 
 class LongRangeHomingTask(GoalReachingTask):
-    """Outbound route then homing (module docstring). ``route_length`` (m, in
+    """Outbound route then homing (module docstring). The robot starts where the previous
+    episode may have ended (the same seed's home, e.g. after a one-step episode); PyBullet
+    keeps contact points cached there by proximity, with their warm-start impulses, which
+    would make this episode depend on the last: ``fresh_contacts`` clears them. ``route_length`` (m, in
     ``[0.5, 30]``), ``outbound_speed`` (m/s) and ``outbound_yaw_rate`` (rad/s, both at
     most the robot's limits, checked by the env), ``clearance_margin`` (m) of the home
     pose and of the route; ``success_radius``, ``success_on`` and ``reward`` as in
     :class:`GoalReachingTask`."""
+
+    fresh_contacts = True
 
     def __init__(self, route_length: float = 8.0, outbound_speed: float = 0.15,
                  outbound_yaw_rate: float = 0.5, success_radius: float = 0.2,
@@ -85,11 +90,9 @@ class LongRangeHomingTask(GoalReachingTask):
                  clearance_margin: float = 0.3):
         if not (isinstance(route_length, (int, float)) and 0.5 <= route_length <= 30):
             raise ValueError(f"route_length must be in [0.5, 30] metres, got {route_length!r}")
-        for name, value in (("outbound_speed", outbound_speed),
-                            ("outbound_yaw_rate", outbound_yaw_rate),
-                            ("clearance_margin", clearance_margin)):
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-                raise ValueError(f"{name} must be a positive number, got {value!r}")
+        require_positive("outbound_speed", outbound_speed, "m/s")
+        require_positive("outbound_yaw_rate", outbound_yaw_rate, "rad/s")
+        require_positive("clearance_margin", clearance_margin, "metres")
         super().__init__(success_radius, success_on, reward)
         self.route_length = float(route_length)
         self.outbound_speed = float(outbound_speed)
@@ -119,48 +122,38 @@ class LongRangeHomingTask(GoalReachingTask):
         home = sample_free_pose(scene, rng, self.clearance_margin)
         return Episode(home=home, start=home.copy())
 
-    def on_reset(self, env: "HomingEnv") -> None:
-        # The robot starts where the previous episode may have ended (the same seed's
-        # home, e.g. after a one-step episode); PyBullet keeps contact points cached at
-        # that pose by proximity, with their warm-start impulses, which would make this
-        # episode depend on the last. Teleporting away and back clears them.
-        start = env.episode.start
-        env.sim.robot.set_pose(start[0] + 100.0, start[1], start[2])
-        env.sim.robot.set_pose(*start)
-        super().on_reset(env)
-        self.route = plan_route(env.scene, env.episode.start, env.np_random,
+    def on_reset(self, ctx: TaskContext) -> None:
+        super().on_reset(ctx)
+        self.route = plan_route(ctx.scene(), ctx.episode().start, ctx.rng(),
                                 self.route_length, self.clearance_margin)
         self.phase, self.waypoint, self.outbound_steps = OUTBOUND, 1, 0
 
-    def command(self, env: "HomingEnv", v: float, w: float,
+    def command(self, ctx: TaskContext, v: float, w: float,
                 stopped: bool) -> tuple[float, float, bool]:
         """Outbound: the env's own pursuit command (normalised); homing: the agent's."""
         if self.phase == HOMING:
             return v, w, stopped
-        rc = env.robot_config
-        err = bearing_to(env.pose, self.route[self.waypoint])
+        rc = ctx.robot
+        err = bearing_to(ctx.pose(), self.route[self.waypoint])
         yaw = float(np.clip(3.0 * err, -self.outbound_yaw_rate, self.outbound_yaw_rate))
         speed = 0.0 if abs(err) > TURN_FIRST else self.outbound_speed
         return speed / rc.max_speed, yaw / rc.max_yaw_rate, False
 
-    def step_outcome(self, env: "HomingEnv", collision: bool, stopped: bool):
+    def step_outcome(self, ctx: TaskContext, collision: bool, stopped: bool):
         if self.phase == HOMING:
-            return super().step_outcome(env, collision, stopped)
+            return super().step_outcome(ctx, collision, stopped)
         self.outbound_steps += 1
-        if math.dist(env.pose[:2], self.route[self.waypoint]) < WAYPOINT_RADIUS:
+        if math.dist(ctx.pose()[:2], self.route[self.waypoint]) < WAYPOINT_RADIUS:
             self.waypoint += 1
             if self.waypoint == len(self.route):
                 self.phase = HOMING
-                self._prev_distance = env.distance_to_goal
+                self._prev_distance = ctx.distance_to_goal()
         rewards = {k: 0.0 for k in ("progress", "waypoint", "success", "collision", "time")}
         return rewards, False, False
 
-    def extra_spaces(self) -> dict[str, spaces.Space]:
-        return {"phase": spaces.Discrete(2)}
+    def observation_keys(self) -> dict[str, ObservationKey]:
+        return {"phase": constant_key(spaces.Discrete(2), lambda: np.int64(self.phase))}
 
-    def extra_observation(self, env: "HomingEnv") -> dict[str, np.ndarray]:
-        return {"phase": np.int64(self.phase)}
-
-    def extra_info(self, env: "HomingEnv") -> dict:
+    def extra_info(self, ctx: TaskContext) -> dict:
         return {"phase": self.phase, "outbound_steps": self.outbound_steps,
                 "route": self.route.copy()}

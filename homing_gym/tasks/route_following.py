@@ -5,19 +5,17 @@ before the first)."""
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-from homing_gym.geometry import wrap_angle
+from homing_gym.geometry import FOOT, wrap_angle
 from homing_gym.scenes.base import Scene, clearance
+from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.base import Episode
 from homing_gym.tasks.goal_reaching import GoalReachingTask, RewardConfig
+from homing_gym.validation import require_positive
 
-if TYPE_CHECKING:
-    from homing_gym.env import HomingEnv
 
-FOOT = 0.3048
 
 
 class RouteFollowingTask(GoalReachingTask):
@@ -35,8 +33,7 @@ class RouteFollowingTask(GoalReachingTask):
                  reward: RewardConfig = RewardConfig(), clearance_margin: float = 0.18):
         if not (isinstance(n_targets, (int, np.integer)) and n_targets >= 1):
             raise ValueError(f"n_targets must be an integer >= 1, got {n_targets!r}")
-        if not (math.isfinite(spacing) and spacing > 0):
-            raise ValueError(f"spacing must be a positive number of metres, got {spacing!r}")
+        require_positive("spacing", spacing, "metres")
         if len(start_jitter) != 2 or not all(math.isfinite(v) and v >= 0 for v in start_jitter):
             raise ValueError(f"start_jitter must be (metres, radians) >= 0, got {start_jitter!r}")
         super().__init__(success_radius, success_on, reward)
@@ -68,5 +65,5 @@ class RouteFollowingTask(GoalReachingTask):
         start[2] = wrap_angle(start[2])
         return Episode(home=targets[-1], start=start, waypoints=tuple(targets[:-1]))
 
-    def extra_info(self, env: "HomingEnv") -> dict:
-        return {"target_index": env.goal_index, "target_errors": list(self.goal_errors)}
+    def extra_info(self, ctx: TaskContext) -> dict:
+        return {"target_index": ctx.goal_index(), "target_errors": list(self.goal_errors)}

@@ -15,20 +15,20 @@ counts), never through ``info``.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from functools import partial
 
 import numpy as np
 from gymnasium import spaces
 
-from homing_gym.geometry import to_frame, wrap_angle
+from homing_gym.geometry import wrap_angle
+from homing_gym.observations import ObservationKey, constant_key
 from homing_gym.scenes.base import Scene
+from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.base import Episode
 from homing_gym.tasks.goal_reaching import GoalReachingTask, RewardConfig
 from homing_gym.teaching import (PLACE_SPACING, FeatureMap, low_resolution_shape,
                                  teach_path, teach_work_location)
 
-if TYPE_CHECKING:
-    from homing_gym.env import HomingEnv
 
 #: Most taught places on one path (15 m at 0.47 m) and characteristic points per map
 #: (the paper's map of Fig. 2 holds 10).
@@ -129,13 +129,13 @@ class WorkLocationsTask(GoalReachingTask):
         return Episode(home=np.asarray(places[self.path[1]], np.float64), start=start)
 
     # -- teaching -----------------------------------------------------------------------------
-    def on_reset(self, env: "HomingEnv") -> None:
-        goal = env.scene.metadata["work_locations"][self.path[1]]
-        if not np.allclose(env.episode.home, goal):
+    def on_reset(self, ctx: TaskContext) -> None:
+        goal = ctx.scene().metadata["work_locations"][self.path[1]]
+        if not np.allclose(ctx.episode().home, goal):
             raise ValueError(f"the goal of WorkLocations-v0 is the work location "
                              f"{self.path[1]!r} at {goal}; reset option 'home' cannot move it")
         if self.path not in self._paths or self.path[1] not in self._maps:
-            self._teach(env)
+            self._teach(ctx)
         images, _ = self._paths[self.path]
         fmap = self._maps[self.path[1]]
         h, w = self.low_shape
@@ -152,35 +152,33 @@ class WorkLocationsTask(GoalReachingTask):
                      "map_panorama": fmap.panorama, "map_templates": templates,
                      "map_template_xy": xy, "map_points": points, "map_count": np.int64(n),
                      "map_pose": fmap.pose.astype(np.float32)}
-        super().on_reset(env)
+        super().on_reset(ctx)
 
-    def _teach(self, env: "HomingEnv") -> None:
+    def _teach(self, ctx: TaskContext) -> None:
         """Teach the episode's path and its target location in the taught scene, then
         restore the run's world with the robot at the start."""
-        run_scene, taught = env.scene, self.taught_scene
+        run_scene, taught = ctx.scene(), self.taught_scene
         if taught != run_scene:
-            env.sim.reset_world(taught)
+            ctx.use_world(taught)
         meta = taught.metadata
         if self.path not in self._paths:
-            self._paths[self.path] = teach_path(env, meta["paths"][self.path], self.levels,
-                                                self.spacing)
+            self._paths[self.path] = teach_path(ctx.snapshot, meta["paths"][self.path],
+                                                self.levels, self.spacing)
         goal = self.path[1]
         if goal not in self._maps:
             self._maps[goal] = teach_work_location(
-                env, meta["work_locations"][goal], meta["feature_points"], self.levels,
+                ctx.snapshot, ctx.ray_hit, ctx.robot.camera_height, ctx.camera.vfov,
+                meta["work_locations"][goal], meta["feature_points"], self.levels,
                 self.template_size, self.max_points)
         if taught != run_scene:
-            env.sim.reset_world(run_scene)
-        robot = env.sim.robot
-        robot.set_pose(*env.episode.start)
-        env.pose = robot.pose()
-        env.odometry.reset(to_frame(env.episode.home, env.pose), robot.wheel_angles())
+            ctx.use_world(run_scene)
+        ctx.place_robot(ctx.episode().start)
 
     # -- observations -------------------------------------------------------------------------
-    def extra_spaces(self) -> dict[str, spaces.Space]:
+    def observation_keys(self) -> dict[str, ObservationKey]:
         h, w = self.low_shape
         t = self.template_size
-        return {
+        taught = {
             "path_panoramas": spaces.Box(0, 255, (MAX_PLACES, h, w), np.uint8),
             "path_count": spaces.Discrete(MAX_PLACES + 1),
             "map_panorama": spaces.Box(0, 255, (h, w), np.uint8),
@@ -190,12 +188,14 @@ class WorkLocationsTask(GoalReachingTask):
             "map_count": spaces.Discrete(MAX_POINTS + 1),
             "map_pose": spaces.Box(-np.inf, np.inf, (3,), np.float32),
         }
+        return {key: constant_key(space, partial(self._taught_value, key))
+                for key, space in taught.items()}
 
-    def extra_observation(self, env: "HomingEnv") -> dict[str, np.ndarray]:
-        return {k: (v.copy() if isinstance(v, np.ndarray) else v)
-                for k, v in self._obs.items() if k in env.obs_keys}
+    def _taught_value(self, key: str) -> np.ndarray:
+        value = self._obs[key]
+        return value.copy() if isinstance(value, np.ndarray) else value
 
-    def extra_info(self, env: "HomingEnv") -> dict:
+    def extra_info(self, ctx: TaskContext) -> dict:
         places = self._paths.get(self.path, (None, np.zeros((0, 3))))[1]
         return {"start_location": self.path[0], "goal_location": self.path[1],
                 "places": places.copy()}
