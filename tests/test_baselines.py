@@ -8,7 +8,8 @@ import pytest
 
 import homing_baselines
 from homing_baselines.motion import MotionHelper, MotionSpec, Move, integrate
-from homing_train.harness.evaluate import prepare_policy, run_episode
+from homing_train.harness.evaluate import run_episode
+from homing_train.harness.rollout import prepare_policy
 from homing_train.harness.policies import parse_params
 
 ENV_ID = "homing_gym/LocalHoming-v0"

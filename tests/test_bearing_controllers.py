@@ -11,7 +11,8 @@ from homing_gym.envs import LocalHomingEnv
 from homing_gym.scenes import available_scenes, scene_factory
 from homing_gym.scenes.base import clearance
 from homing_gym.simulator import Simulator
-from homing_train.harness.evaluate import evaluate, prepare_policy, run_episode
+from homing_train.harness.evaluate import evaluate, run_episode
+from homing_train.harness.rollout import prepare_policy
 
 ENV_ID = "homing_gym/LocalHoming-v0"
 #: The region each marked position must lie in (Fig. 9b).

@@ -11,7 +11,8 @@ import pytest
 import homing_baselines
 from homing_baselines.bearing_longrange import birth_frames, choose_milestones, median_offset
 from homing_baselines.klt import KLTConfig
-from homing_train.harness.evaluate import prepare_policy, run_episode
+from homing_train.harness.evaluate import run_episode
+from homing_train.harness.rollout import prepare_policy
 
 
 def test_milestones_are_the_earliest_frames_sharing_enough_features():

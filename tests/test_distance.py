@@ -156,7 +156,8 @@ def test_controller_reaches_home_from_1m_in_arena():
     one (docs/yu_kim.md), so that episode fails (a limit of the method, not hidden)."""
     gym = pytest.importorskip("gymnasium")
     import homing_gym  # noqa: F401
-    from homing_train.harness.evaluate import prepare_policy, run_episode
+    from homing_train.harness.evaluate import run_episode
+    from homing_train.harness.rollout import prepare_policy
 
     env = gym.make("homing_gym/LocalHoming-v0", obs_keys=("panorama", "goal", "goal_step"),
                    max_episode_steps=300)

@@ -12,7 +12,7 @@ import pytest
 import homing_baselines
 from homing_baselines.motion import FORWARD, LEFT, RIGHT, MotionHelper
 from homing_gym.geometry import wrap_angle
-from homing_train.harness.evaluate import prepare_policy
+from homing_train.harness.rollout import prepare_policy
 from homing_train.learning.pretrain import pair_labels, pair_samples, pair_set, render_bank, rolled
 from homing_train.learning.train import main
 

@@ -16,7 +16,8 @@ from homing_baselines.selfsimilar_detector import Detection
 from homing_baselines.selfsimilar_panel import PanelPose
 from homing_gym.geometry import wrap_angle
 from homing_gym.tasks.landmark_navigation import N_IDS
-from homing_train.harness.evaluate import prepare_policy, run_episode
+from homing_train.harness.evaluate import run_episode
+from homing_train.harness.rollout import prepare_policy
 
 
 def test_registered_with_its_observation_keys_and_checks_its_parameters():

@@ -189,7 +189,8 @@ def test_route_first_targets_in_stop_mode(make_env):
                    "red cylinders 0.5 m from its centre) is smaller than 0.5 m: see docs/hong.md")
 def test_controller_reaches_home_from_half_a_metre_in_the_arena(make_env):
     env = make_env(panorama_shape=PANORAMA, start_distance=(0.5, 0.5), success_on="stop")
-    from homing_train.harness.evaluate import prepare_policy, run_episode
+    from homing_train.harness.evaluate import run_episode
+    from homing_train.harness.rollout import prepare_policy
 
     c = SnapshotController()
     prepare_policy(c, env)

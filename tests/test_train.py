@@ -201,7 +201,7 @@ def test_imitation_fits_the_policy_to_the_oracle_labels(tmp_path):
     model = PPO("MultiInputPolicy", env, n_steps=16, batch_size=16, n_epochs=1, seed=0,
                 learning_rate=1e-3, policy_kwargs=policy_kwargs_for("panorama", features_dim=16))
     import homing_baselines
-    from homing_train.harness.evaluate import prepare_policy
+    from homing_train.harness.rollout import prepare_policy
 
     oracle = homing_baselines.make("oracle")
     prepare_policy(oracle, env)

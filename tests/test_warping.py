@@ -96,7 +96,8 @@ def test_rendered_pairs_03m_apart_point_home(arena):
 
 
 def test_controller_reaches_home_from_05m(arena):
-    from homing_train.harness.evaluate import prepare_policy, run_episode
+    from homing_train.harness.evaluate import run_episode
+    from homing_train.harness.rollout import prepare_policy
 
     controller = WarpingController()
     prepare_policy(controller, arena)

@@ -238,7 +238,8 @@ def lab_run(env, law: str, start: Sequence[float], goal: str | Sequence[float],
     ``(x, y, yaw)`` to ``goal``, a marked position's name or a point ``(x, y)`` (m):
     final error (cm), stopped, steps."""
     import homing_baselines
-    from homing_train.harness.evaluate import prepare_policy, run_episode
+    from homing_train.harness.evaluate import run_episode
+    from homing_train.harness.rollout import prepare_policy
 
     controller = homing_baselines.make(PIXEL_LAWS[law])
     prepare_policy(controller, env)
@@ -440,7 +441,8 @@ def longrange(out: str, episodes: int = 10, seed: int = 0, route_length: float =
 
     import homing_baselines
     import homing_gym
-    from homing_train.harness.evaluate import prepare_policy, run_episode
+    from homing_train.harness.evaluate import run_episode
+    from homing_train.harness.rollout import prepare_policy
 
     gym.register_envs(homing_gym)
     env = gym.make("homing_gym/LongRangeHoming-v0", route_length=route_length,

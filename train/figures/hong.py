@@ -29,7 +29,8 @@ import homing_gym
 from homing_baselines.snapshot import HongConfig, hong_homing
 from homing_gym.geometry import bearing_to, wrap_angle
 from homing_gym.scenes.base import clearance
-from homing_train.harness.evaluate import evaluate, prepare_policy
+from homing_train.harness.evaluate import evaluate
+from homing_train.harness.rollout import prepare_policy, rollout
 from homing_train.harness.field import homing_field, plot_field
 from homing_train.harness.policies import policy_spec
 
@@ -201,13 +202,7 @@ def run_routes(names: list[str], episodes: int = 20) -> dict[str, Any]:
             prepare_policy(policy, env)
             all_ok, errors, n_done, last_ok = [], [], [], []
             for seed in tqdm(range(episodes), desc=f"{name} route light={light}"):
-                obs, info = env.reset(seed=seed)
-                policy.reset(seed)
-                done = False
-                while not done:
-                    action, _ = policy.predict(obs)
-                    obs, _, term, trunc, info = env.step(action)
-                    done = term or trunc
+                info = rollout(env, policy, seed).info
                 errs = list(info["target_errors"])      # read by the harness only
                 errors.extend(errs)
                 n_done.append(len(errs))

@@ -32,7 +32,7 @@ from homing_baselines.multires import LOCALISE
 from homing_baselines.multires_localise import localise
 from homing_gym.scenes.base import clearance
 from homing_gym.teaching import FeatureMap
-from homing_train.harness.evaluate import prepare_policy
+from homing_train.harness.rollout import prepare_policy, rollout
 
 ENV_ID = "homing_gym/WorkLocations-v0"
 LOCATIONS = ("home", "kitchen", "bedroom")
@@ -107,19 +107,18 @@ def travel_experiment(episodes: int, seed: int, daily_changes: float) -> list[di
     prepare_policy(controller, env)
     rows = []
     for s in range(seed, seed + episodes):
-        obs, info = env.reset(seed=s)
-        controller.reset(s)
-        arrival, done, steps = None, False, 0
-        while not done:
-            action, _ = controller.predict(obs, episode_start=steps == 0)
-            if arrival is None and controller.phase == LOCALISE:
-                arrival = env.unwrapped.distance_to_goal
-            obs, _, terminated, truncated, info = env.step(action)
-            done, steps = terminated or truncated, steps + 1
+        arrival: list[float] = []
+
+        def localising(t, obs, action, info) -> None:
+            if not arrival and controller.phase == LOCALISE:
+                arrival.append(info["distance_to_goal"])
+
+        run = rollout(env, controller, s, on_step=localising)
+        info = run.info
         rows.append({"seed": s, "path": [info["start_location"], info["goal_location"]],
-                     "arrival_cm": None if arrival is None else 100 * arrival,
+                     "arrival_cm": 100 * arrival[0] if arrival else None,
                      "final_cm": 100 * info["distance_to_goal"], "success": info["is_success"],
-                     "steps": steps, "collisions": info["collisions"]})
+                     "steps": run.steps, "collisions": info["collisions"]})
         print(rows[-1], flush=True)
     env.close()
     return rows

@@ -28,28 +28,27 @@ from tqdm import tqdm  # noqa: E402
 
 import homing_gym  # noqa: E402,F401
 from homing_gym.panorama import bearing_column  # noqa: E402
+from homing_train.harness.rollout import prepare_policy, rollout  # noqa: E402
 
 
 def run_episode(env: gym.Env, seed: int, controller_name: str = "oracle"):
     """Frames and final info of one episode driven by a registered controller."""
     import homing_baselines
-    from homing_baselines.motion import MotionSpec
 
     controller = homing_baselines.make(controller_name)
-    controller.configure(MotionSpec.from_env(env))
-    if controller.needs_env:
-        controller.attach_env(env)
-    obs, info = env.reset(seed=seed)
-    controller.reset(seed)
-    frames = [env.render()]
+    prepare_policy(controller, env)
+    frames = []
     limit = env.spec.max_episode_steps or 500
-    for _ in tqdm(range(limit), desc=f"demo episode (seed {seed})"):
-        action, _ = controller.predict(obs)
-        obs, _, terminated, truncated, info = env.step(action)
+    bar = tqdm(total=limit, desc=f"demo episode (seed {seed})")
+
+    def record(t, obs, action, info) -> None:
         frames.append(env.render())
-        if terminated or truncated:
-            break
-    return frames, info
+        bar.update()
+
+    run = rollout(env, controller, seed, on_step=record)
+    bar.close()
+    frames.append(env.render())
+    return frames, run.info
 
 
 def views_figure(env: gym.Env, seed: int, path: Path) -> None:

@@ -29,11 +29,11 @@ import numpy as np
 from tqdm import tqdm
 
 import homing_gym
-from homing_baselines.motion import MotionSpec
 from homing_gym.paths import NoPathError, path_length, shortest_path
 from homing_gym.geometry import wrap_angle
 from homing_train.harness import metrics
 from homing_train.harness.policies import PolicySpec, parse_params, policy_spec
+from homing_train.harness.rollout import prepare_policy, rollout
 
 SCHEMA = 1
 DEFAULT_ENV = "homing_gym/LocalHoming-v0"
@@ -169,17 +169,6 @@ def summarize(episodes: Sequence[EpisodeRecord], bin_width: float = 0.3,
 
 
 # -- running episodes ---------------------------------------------------------------------
-def prepare_policy(policy, env: gym.Env) -> None:
-    """Hand the policy what it may know: the command interface; the env itself only to
-    controllers that declare ``needs_env`` (oracles)."""
-    if hasattr(policy, "check_env"):
-        policy.check_env(env)
-    if hasattr(policy, "configure"):
-        policy.configure(MotionSpec.from_env(env))
-    if getattr(policy, "needs_env", False):
-        policy.attach_env(env)
-
-
 def _geodesic(scene, a, b, radius: float) -> float:
     try:
         return path_length(shortest_path(scene, a, b, radius))
@@ -189,45 +178,32 @@ def _geodesic(scene, a, b, radius: float) -> float:
 
 def run_episode(env: gym.Env, policy, seed: int, start: Sequence[float] | None = None,
                 home: Sequence[float] | None = None) -> EpisodeRecord:
-    """Run one episode of ``policy`` (which receives the observation only) and measure it.
-    ``start`` and ``home`` override the start and home poses (x, y, yaw): the homing
-    field sets the start, a fixed-nest evaluation (Yu & Kim Fig. 6) both."""
+    """Run one episode of ``policy`` (which receives the observation only) and measure it
+    from ``info``. ``start`` and ``home`` override the start and home poses (x, y, yaw):
+    the homing field sets the start, a fixed-nest evaluation (Yu & Kim Fig. 6) both."""
     t0 = time.perf_counter()
     options = {key: [float(v) for v in pose] for key, pose in (("start", start), ("home", home))
-               if pose is not None} or None
-    obs, info = env.reset(seed=int(seed), options=options)
-    u = env.unwrapped
-    home = np.asarray(u.episode.home, dtype=np.float64)
-    start_pose = np.asarray(u.pose, dtype=np.float64).copy()
-    radius = u.robot_config.body_radius
-    if hasattr(policy, "reset"):
-        policy.reset(int(seed))
-    state, episode_start = None, True
-    steps, done, info = 0, False, {"is_success": False, "collisions": 0}
-    terminated = truncated = False
-    while not done:
-        action, state = policy.predict(obs, state=state, episode_start=episode_start)
-        episode_start = False
-        if not getattr(policy, "needs_next_observation", lambda: True)():
-            u.skip_next_images()        # mid-move: the images would go unread
-        obs, _, terminated, truncated, info = env.step(action)
-        steps += 1
-        done = terminated or truncated
-    traj = np.asarray(u.trajectory, dtype=np.float64)
-    final = np.asarray(u.pose, dtype=np.float64)
-    d_start = float(math.dist(start_pose[:2], home[:2]))
-    shortest = _geodesic(u.scene, start_pose, home, radius)
-    final_geodesic = _geodesic(u.scene, final, home, radius)
+               if pose is not None}
+    run = rollout(env, policy, seed, options)
+    home = np.asarray(run.reset_info["home_pose"], dtype=np.float64)
+    start_pose = np.asarray(run.reset_info["start_pose"], dtype=np.float64)
+    # the scene and the body radius are public attributes, read for path-length metrics
+    scene, radius = env.unwrapped.scene, env.unwrapped.robot_config.body_radius
+    traj = run.poses[:, :2]
+    final = run.poses[-1]
+    shortest = _geodesic(scene, start_pose, home, radius)
+    final_geodesic = _geodesic(scene, final, home, radius)
     p = path_length(traj)
-    success = bool(info.get("is_success", False))
+    success = bool(run.info.get("is_success", False))
     return EpisodeRecord(
         seed=int(seed), start_pose=[round(float(v), 4) for v in start_pose],
-        home_pose=[round(float(v), 4) for v in home], start_distance=d_start,
-        shortest_path=shortest, success=success, terminated=bool(terminated),
-        truncated=bool(truncated), steps=steps, path_length=p,
+        home_pose=[round(float(v), 4) for v in home],
+        start_distance=float(math.dist(start_pose[:2], home[:2])),
+        shortest_path=shortest, success=success, terminated=run.terminated,
+        truncated=run.truncated, steps=run.steps, path_length=p,
         final_distance=float(math.dist(final[:2], home[:2])),
         min_distance=float(np.min(np.hypot(traj[:, 0] - home[0], traj[:, 1] - home[1]))),
-        collisions=int(info.get("collisions", 0)), spl=metrics.spl(success, shortest, p),
+        collisions=int(run.info.get("collisions", 0)), spl=metrics.spl(success, shortest, p),
         soft_spl=metrics.soft_spl(final_geodesic, shortest, p),
         final_heading_error_deg=abs(math.degrees(wrap_angle(final[2] - home[2]))),
         wall_time=time.perf_counter() - t0,

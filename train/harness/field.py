@@ -37,9 +37,10 @@ import numpy as np  # noqa: E402
 from homing_gym.geometry import wrap_angle  # noqa: E402
 from homing_gym.scenes.base import clearance  # noqa: E402
 from homing_gym.topdown import HOME, MapCanvas, draw_pose, draw_scene  # noqa: E402
-from homing_train.harness.evaluate import (DEFAULT_ENV, add_policy_arguments, parse_json_kwargs,  # noqa: E402
-                            policy_from_args, prepare_policy, run_episodes)
+from homing_train.harness.evaluate import (DEFAULT_ENV, add_policy_arguments,  # noqa: E402
+                                           parse_json_kwargs, policy_from_args, run_episodes)
 from homing_train.harness.policies import PolicySpec, policy_spec  # noqa: E402
+from homing_train.harness.rollout import prepare_policy, rollout  # noqa: E402
 
 RETURNED, FAILED, UNKNOWN = (40, 160, 60), (210, 50, 40), (40, 90, 200)
 
@@ -86,19 +87,18 @@ def first_home_decision(env: gym.Env, controller, pose, seed: int,
     direction (at once for most methods; after its measuring step for distance estimation,
     as in Yu & Kim Fig. 10). Returns the robot pose at that decision and the direction
     (robot frame, radians), or ``None`` if none came within ``max_steps`` steps."""
-    obs, _ = env.reset(seed=seed, options={"start": [float(v) for v in pose]})
-    controller.reset(seed)
-    episode_start = True
-    for _ in range(max_steps):
-        at = np.asarray(env.unwrapped.pose, dtype=np.float64).copy()
-        action, _ = controller.predict(obs, episode_start=episode_start)
-        episode_start = False
-        if controller.last_home_direction is not None:
-            return at, controller.last_home_direction
-        obs, _, terminated, truncated, _ = env.step(action)
-        if terminated or truncated:
-            break
-    return np.asarray(pose, dtype=np.float64), None
+    decision: list = []
+
+    def stated(t, obs, action, info) -> bool:
+        if controller.last_home_direction is None:
+            return False
+        decision.append((np.asarray(info["pose"], dtype=np.float64).copy(),
+                         controller.last_home_direction))
+        return True
+
+    rollout(env, controller, seed, {"start": [float(v) for v in pose]}, on_step=stated,
+            max_steps=max_steps)
+    return decision[0] if decision else (np.asarray(pose, dtype=np.float64), None)
 
 
 def homing_field(policy, env_id: str = DEFAULT_ENV, grid: float = 0.2, seed: int = 0,
@@ -113,9 +113,9 @@ def homing_field(policy, env_id: str = DEFAULT_ENV, grid: float = 0.2, seed: int
     env_kwargs = dict(env_kwargs or {})
     env = gym.make(env_id, **env_kwargs)
     try:
-        env.reset(seed=seed)
+        _, info = env.reset(seed=seed)
         u = env.unwrapped
-        home = np.asarray(u.episode.home, dtype=np.float64)
+        home = np.asarray(info["home_pose"], dtype=np.float64)
         radius = getattr(u.task, "success_radius", 0.15)
         xy = grid_points(u.scene, home, grid, margin, radius)
         if len(xy) == 0:

@@ -27,7 +27,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 import homing_baselines
-from homing_train.harness.evaluate import prepare_policy
+from homing_train.harness.rollout import prepare_policy, rollout
 
 
 @dataclass
@@ -49,29 +49,41 @@ def oracle_label(oracle, observation) -> int | np.ndarray:
     return action
 
 
+class DaggerMixture:
+    """The DAgger behaviour policy (Ross et al. 2011): in each state it acts with the
+    oracle's label with probability ``beta``, else with an action sampled from ``model``;
+    it records every visited observation, its oracle label and whether the model's most
+    likely action agreed."""
+
+    def __init__(self, oracle, model, beta: float, rng: np.random.Generator,
+                 keys: list[str]):
+        self.oracle, self.model, self.beta, self.rng = oracle, model, beta, rng
+        self.observations: dict[str, list] = {k: [] for k in keys}
+        self.labels: list = []
+        self.agree: list[bool] = []
+
+    def predict(self, obs, state=None, episode_start=None):
+        label = oracle_label(self.oracle, obs)
+        mine, _ = self.model.predict(obs, deterministic=True)
+        self.agree.append(bool(np.array_equal(np.asarray(mine), np.asarray(label))))
+        for key, value in obs.items():
+            self.observations[key].append(value)
+        self.labels.append(label)
+        if self.rng.random() < self.beta:
+            return label, state
+        action, _ = self.model.predict(obs, deterministic=False)
+        return action, state
+
+
 def collect(env: gym.Env, oracle, model, beta: float, episodes: int, seed: int,
             rng: np.random.Generator) -> tuple[dict[str, list], list, float]:
     """Run ``episodes`` (seeds ``seed..``) mixing oracle and policy actions; returns the
     visited observations, their oracle labels and the policy's agreement with them."""
-    observations: dict[str, list] = {k: [] for k in env.observation_space.spaces}
-    labels, agree = [], []
+    mixture = DaggerMixture(oracle, model, beta, rng, list(env.observation_space.spaces))
     for i in range(episodes):
-        obs, _ = env.reset(seed=seed + i)
-        done = False
-        while not done:
-            label = oracle_label(oracle, obs)
-            mine, _ = model.predict(obs, deterministic=True)
-            agree.append(bool(np.array_equal(np.asarray(mine), np.asarray(label))))
-            for key, value in obs.items():
-                observations[key].append(value)
-            labels.append(label)
-            if rng.random() < beta:
-                action = label
-            else:
-                action, _ = model.predict(obs, deterministic=False)
-            obs, _, terminated, truncated, _ = env.step(action)
-            done = terminated or truncated
-    return observations, labels, float(np.mean(agree)) if agree else 0.0
+        rollout(env, mixture, seed + i)
+    agreement = float(np.mean(mixture.agree)) if mixture.agree else 0.0
+    return mixture.observations, mixture.labels, agreement
 
 
 def fit(model, observations: dict[str, np.ndarray], labels: np.ndarray, epochs: int,

@@ -109,9 +109,10 @@ def _space(entry: dict, path: str) -> spaces.Space:
                                        f"{text!r} without unpickling (only Box members)")
         return spaces.Dict(members)
     if "spaces.box.Box" in kind:
-        shape = tuple(ast.literal_eval(entry["_shape"]))
-        low = _number_array(entry.get("low_repr", entry.get("low", "")))
-        high = _number_array(entry.get("high_repr", entry.get("high", "")))
+        shape = entry["_shape"]
+        shape = tuple(ast.literal_eval(shape) if isinstance(shape, str) else shape)
+        low = _number_array(str(entry.get("low_repr") or entry.get("low", "")))
+        high = _number_array(str(entry.get("high_repr") or entry.get("high", "")))
         return spaces.Box(low.reshape(shape) if low.size > 1 else float(low[0]),
                           high.reshape(shape) if high.size > 1 else float(high[0]), shape,
                           np.dtype(entry["dtype"]))

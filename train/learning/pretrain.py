@@ -34,7 +34,7 @@ import homing_baselines
 from homing_baselines.motion import MotionHelper
 from homing_gym.scenes.base import Scene
 from homing_gym.tasks.base import sample_free_pose
-from homing_train.harness.evaluate import prepare_policy
+from homing_train.harness.rollout import prepare_policy
 from homing_train.learning.imitation import fit
 
 #: Observation keys a bank can produce.
