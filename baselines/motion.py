@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from homing_gym.actions import DiscreteAction
 from homing_gym.geometry import wrap_angle
 
 MOTION_STYLES = ("turn_then_drive", "pursuit")
@@ -76,8 +77,9 @@ class MotionSpec:
         return self.max_speed * self.control_period
 
 
-#: Discrete action indices of the env (see ``homing_gym.env.DISCRETE_ACTIONS``).
-FORWARD, LEFT, RIGHT, STOP = 0, 1, 2, 3
+#: Discrete actions of the env (:class:`homing_gym.actions.DiscreteAction`).
+FORWARD, LEFT, RIGHT, STOP = (DiscreteAction.FORWARD, DiscreteAction.TURN_LEFT,
+                              DiscreteAction.TURN_RIGHT, DiscreteAction.STOP)
 
 
 class MotionHelper:
@@ -164,15 +166,11 @@ def unicycle_step(pose, v: float, w: float, spec: MotionSpec) -> tuple[float, fl
             y - vv / ww * (math.cos(yaw + ww * dt) - math.cos(yaw)), yaw + ww * dt)
 
 
-#: Normalised (v, w) of each discrete action.
-DISCRETE_COMMANDS = {FORWARD: (1.0, 0.0), LEFT: (0.0, 1.0), RIGHT: (0.0, -1.0), STOP: (0.0, 0.0)}
-
-
 def integrate(actions: list, spec: MotionSpec) -> np.ndarray:
     """Ideal unicycle pose ``(x, y, yaw)`` reached from the origin by ``actions``
     (the kinematic model, for tests and dead reckoning)."""
     pose = (0.0, 0.0, 0.0)
     for a in actions:
-        v, w = DISCRETE_COMMANDS[int(a)] if spec.action_type == "discrete" else (a[0], a[1])
+        v, w = DiscreteAction(int(a)).command if spec.action_type == "discrete" else (a[0], a[1])
         pose = unicycle_step(pose, float(v), float(w), spec)
     return np.array([pose[0], pose[1], wrap_angle(pose[2])])

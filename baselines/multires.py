@@ -40,8 +40,9 @@ from homing_baselines.multires_localise import LocaliseConfig, localise
 from homing_baselines.multires_matching import arrival_scores, front_view, locate_on_path
 from homing_gym import TAUGHT_KEYS
 from homing_gym.geometry import to_frame
-from homing_gym.teaching import FeatureMap, grey, low_resolution
+from homing_gym.teaching import FeatureMap
 from homing_gym.validation import require_positive
+from homing_gym.vision import grey, low_resolution
 
 TRAVEL, ARRIVE, LOCALISE = "travel", "arrive", "localise"
 

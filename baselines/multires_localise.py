@@ -36,7 +36,8 @@ from homing_baselines.multires_matching import (find_template, front_view, match
                                          predicted_directions, triangulate)
 from homing_gym.geometry import wrap_angle
 from homing_gym.panorama import bearing_column, column_bearing, row_elevation
-from homing_gym.teaching import FeatureMap, grey, low_resolution
+from homing_gym.teaching import FeatureMap
+from homing_gym.vision import grey, low_resolution
 
 
 @dataclass(frozen=True)

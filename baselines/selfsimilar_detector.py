@@ -49,7 +49,7 @@ import numpy as np
 
 from homing_baselines.camera_models import CameraModel
 from homing_gym.geometry import wrap_angle
-from homing_gym.panorama import LUMA
+from homing_gym.vision import luminance
 from homing_gym.selfsimilar import (BARCODE_BANDS, DEFAULT_P, PanelLayout, check_p,
                                     decode_barcode)
 
@@ -147,10 +147,7 @@ class Detection:
 
 def to_gray(image: np.ndarray) -> np.ndarray:
     """Luminance in ``[0, 1]`` (float32) of a uint8 RGB or grey image."""
-    img = np.asarray(image)
-    if img.ndim == 3:
-        img = img[..., :3].astype(np.float32) @ LUMA
-    return (img / 255.0).astype(np.float32)
+    return luminance(image)
 
 
 def _taps(p: float, w: int) -> list[tuple[int, int, float, int, float]]:

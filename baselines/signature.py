@@ -26,7 +26,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from homing_gym.panorama import LUMA, bearing_column, omni_horizon_radius, signature_weights
+from homing_gym.panorama import bearing_column, omni_horizon_radius, signature_weights
+from homing_gym.vision import luminance
 
 
 def bearing_grid(n: int) -> np.ndarray:
@@ -39,7 +40,7 @@ def bearing_grid(n: int) -> np.ndarray:
 def _luminance(image: np.ndarray) -> np.ndarray:
     if image.ndim != 3 or image.shape[2] != 3:
         raise ValueError(f"expected an RGB image (H, W, 3), got shape {image.shape}")
-    return image.astype(np.float32) @ LUMA / 255.0
+    return luminance(image)
 
 
 def columns_to_bearings(column_signature: np.ndarray, n: int = 360) -> np.ndarray:

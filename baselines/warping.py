@@ -42,7 +42,8 @@ import numpy as np
 from homing_baselines.base import Controller
 from homing_baselines.motion import Move
 from homing_gym.geometry import wrap_angle
-from homing_gym.panorama import LUMA, bearing_column, column_bearing, signature_weights
+from homing_gym.panorama import bearing_column, column_bearing, signature_weights
+from homing_gym.vision import horizon_line
 
 
 @dataclass(frozen=True)
@@ -88,8 +89,7 @@ def horizon_image(panorama: np.ndarray, config: WarpingConfig = WarpingConfig())
     H, W = panorama.shape[:2]
     if config.rows > H - 2:
         raise ValueError(f"rows={config.rows} does not fit a panorama {H} rows high")
-    gray = panorama.astype(np.float32) @ LUMA / 255.0
-    line = signature_weights(H, config.rows) @ gray
+    line = horizon_line(panorama, signature_weights(H, config.rows))
     return smooth_ring(line.astype(np.float64), config.smooth_deg)
 
 

@@ -36,12 +36,13 @@ def register_envs() -> None:
 
 register_envs()
 
+from homing_gym.actions import DiscreteAction  # noqa: E402
 from homing_gym.env import HomingEnv  # noqa: E402
 from homing_gym.geometry import FOOT  # noqa: E402
 from homing_gym.tasks.work_locations import TAUGHT_KEYS  # noqa: E402
 from homing_gym.envs import (LandmarkNavigationEnv, LocalHomingEnv,  # noqa: E402
                              LongRangeHomingEnv, RouteFollowingEnv, WorkLocationsEnv)
 
-__all__ = ["ENV_IDS", "FOOT", "TAUGHT_KEYS", "HomingEnv", "LandmarkNavigationEnv", "LocalHomingEnv",
+__all__ = ["ENV_IDS", "FOOT", "TAUGHT_KEYS", "DiscreteAction", "HomingEnv", "LandmarkNavigationEnv", "LocalHomingEnv",
            "LongRangeHomingEnv", "RouteFollowingEnv", "WorkLocationsEnv",
            "register_envs", "__version__"]

@@ -16,6 +16,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from homing_gym.actions import DiscreteAction
 from homing_gym.geometry import to_frame
 from homing_gym.observations import CORE_KEYS, ObservationKey, Sight, goal_step_key
 from homing_gym.panorama import CameraConfig, Lighting, PanoramaCamera, random_lighting
@@ -31,9 +32,6 @@ from homing_gym.topdown import compose_frame, draw_topdown
 from homing_gym.validation import require_positive
 
 ACTION_TYPES = ("continuous", "discrete")
-#: Discrete actions: index -> (forward, yaw) in normalised units.
-DISCRETE_ACTIONS = {0: (1.0, 0.0), 1: (0.0, 1.0), 2: (0.0, -1.0), 3: (0.0, 0.0)}
-DISCRETE_NAMES = ("forward", "turn_left", "turn_right", "stop")
 #: Observation keys the env core provides (tasks may add more): see
 #: :mod:`homing_gym.observations`.
 OBSERVATION_KEYS = (*CORE_KEYS, "goal_step")
@@ -111,7 +109,7 @@ class HomingEnv(gym.Env):
         self.observation_space = spaces.Dict(
             {k: entry.space(self.camera.config) for k, entry in self._table.items()})
         if action_type == "discrete":
-            self.action_space = spaces.Discrete(len(DISCRETE_ACTIONS))
+            self.action_space = spaces.Discrete(len(DiscreteAction))
         else:
             self.action_space = spaces.Box(-1.0, 1.0, (2,), np.float32)
 
@@ -224,11 +222,12 @@ class HomingEnv(gym.Env):
         """Validated action -> (forward, yaw) in normalised units and the stop flag."""
         if self.action_type == "discrete":
             if not (np.ndim(action) == 0 and float(action) == int(action)
-                    and int(action) in DISCRETE_ACTIONS):
-                raise ValueError(f"action {action!r} is not one of {list(DISCRETE_ACTIONS)} "
-                                 f"({', '.join(DISCRETE_NAMES)})")
-            v, w = DISCRETE_ACTIONS[int(action)]
-            return v, w, int(action) == 3
+                    and int(action) in iter(DiscreteAction)):
+                names = ", ".join(f"{a.value} {a.name.lower()}" for a in DiscreteAction)
+                raise ValueError(f"action {action!r} is not one of {names}")
+            chosen = DiscreteAction(int(action))
+            v, w = chosen.command
+            return v, w, chosen is DiscreteAction.STOP
         a = np.asarray(action, dtype=np.float64)
         if a.shape != (2,):
             raise ValueError(f"action {action!r} must have shape (2,) = (forward, yaw rate)")

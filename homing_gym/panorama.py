@@ -38,8 +38,9 @@ import numpy as np
 import pybullet as p
 from pybullet_utils.bullet_client import BulletClient
 
+from homing_gym.vision import horizon_line
+
 RENDERERS = ("tiny", "egl")
-LUMA = np.array([0.299, 0.587, 0.114], dtype=np.float32)
 OMNI_INNER, OMNI_OUTER = 0.25, 0.98
 
 
@@ -288,5 +289,4 @@ class PanoramaCamera:
 
     def signature(self, panorama: np.ndarray) -> np.ndarray:
         """Hong 1991 §2 horizon signature: float32 ``(W,)`` luminance in ``[0, 1]``."""
-        gray = panorama.astype(np.float32) @ LUMA
-        return (self._sig_weights @ gray) / 255.0
+        return horizon_line(panorama, self._sig_weights)

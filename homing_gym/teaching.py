@@ -32,8 +32,9 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from homing_gym.panorama import LUMA, bearing_column
+from homing_gym.panorama import bearing_column
 from homing_gym.validation import require_positive
+from homing_gym.vision import grey, low_resolution
 
 #: ``snapshot(pose)``: the full-resolution panorama (RGB uint8) taken with the robot
 #: standing at ``pose`` (x, y, yaw) under teaching-time lighting.
@@ -43,36 +44,6 @@ RayHit = Callable[[np.ndarray, np.ndarray], "np.ndarray | None"]
 
 #: Distance (m) between taught places along a path (§4(1)).
 PLACE_SPACING = 0.47
-
-
-def grey(image: np.ndarray) -> np.ndarray:
-    """Grey levels (ITU-R BT.601 luma) of an RGB uint8 image, uint8."""
-    if image.ndim == 2:
-        return image
-    return np.clip(image.astype(np.float32) @ LUMA + 0.5, 0, 255).astype(np.uint8)
-
-
-def low_resolution(image: np.ndarray, levels: int) -> np.ndarray:
-    """``image`` (RGB or grey uint8) in grey levels, reduced ``levels`` times by
-    ``cv2.pyrDown`` (Gaussian smoothing, then every other row and column). A panorama
-    wraps around horizontally, so it is padded with its own columns first and cropped
-    back, which keeps the reduction seamless at the seam."""
-    if not (isinstance(levels, (int, np.integer)) and 0 <= levels <= 5):
-        raise ValueError(f"levels must be an integer in [0, 5] pyramid steps, got {levels!r}")
-    out = grey(image)
-    for _ in range(levels):
-        pad = 4
-        padded = np.concatenate([out[:, -pad:], out, out[:, :pad]], axis=1)
-        out = cv2.pyrDown(padded)[:, pad // 2:pad // 2 + (out.shape[1] + 1) // 2]
-    return np.ascontiguousarray(out)
-
-
-def low_resolution_shape(shape: tuple[int, int], levels: int) -> tuple[int, int]:
-    """``(H, W)`` of :func:`low_resolution` for an image of ``shape = (H, W)``."""
-    h, w = shape
-    for _ in range(levels):
-        h, w = (h + 1) // 2, (w + 1) // 2
-    return h, w
 
 
 def path_places(points, spacing: float = PLACE_SPACING) -> np.ndarray:

@@ -9,7 +9,8 @@ from homing_gym.panorama import column_bearing
 from homing_gym.scenes.base import clearance
 from homing_gym.scenes.daily_changes import daily_changes
 from homing_gym.scenes.house import house_scene
-from homing_gym.teaching import low_resolution, path_places
+from homing_gym.teaching import path_places
+from homing_gym.vision import low_resolution
 
 ENV_ID = "homing_gym/WorkLocations-v0"
 

@@ -26,8 +26,8 @@ from homing_gym.scenes.base import Scene
 from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.base import Episode
 from homing_gym.tasks.goal_reaching import GoalReachingTask, RewardConfig
-from homing_gym.teaching import (PLACE_SPACING, FeatureMap, low_resolution_shape,
-                                 teach_path, teach_work_location)
+from homing_gym.teaching import PLACE_SPACING, FeatureMap, teach_path, teach_work_location
+from homing_gym.vision import low_resolution_shape
 
 
 #: Most taught places on one path (15 m at 0.47 m) and characteristic points per map
