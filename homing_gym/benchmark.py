@@ -14,7 +14,7 @@ configuration, in the same run:
 
 from __future__ import annotations
 
-import argparse
+import sys
 import json
 import time
 from dataclasses import asdict, dataclass
@@ -24,6 +24,7 @@ import numpy as np
 from tqdm import tqdm
 
 import homing_gym  # noqa: F401  (registers the envs)
+from homing_gym.cli import command_parser
 
 CONFIGS = {
     "default": {},
@@ -107,8 +108,8 @@ def format_table(results: list[BenchmarkResult]) -> str:
     return "\n".join(lines)
 
 
-def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def main(argv: list[str] | None = None) -> int:
+    parser = command_parser("homing-benchmark", __doc__)
     parser.add_argument("--steps", type=int, default=500, help="steps per measurement")
     parser.add_argument("--workers", type=int, default=2, help="AsyncVectorEnv workers")
     parser.add_argument("--json", help="also write the results to this JSON file")
@@ -121,7 +122,8 @@ def main(argv: list[str] | None = None) -> None:
     if args.json:
         with open(args.json, "w") as f:
             json.dump([asdict(r) | {"ratio": r.ratio} for r in results], f, indent=2)
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

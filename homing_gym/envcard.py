@@ -6,13 +6,14 @@ committed pages match the docstrings.
 
 from __future__ import annotations
 
-import argparse
+import sys
 import inspect
 from pathlib import Path
 
 import gymnasium as gym
 
 import homing_gym
+from homing_gym.cli import command_parser
 
 
 def env_card(env_id: str) -> str:
@@ -34,8 +35,8 @@ def card_filename(env_id: str) -> str:
     return env_id.split("/")[-1] + ".md"
 
 
-def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description="write the env cards as Markdown pages")
+def main(argv: list[str] | None = None) -> int:
+    parser = command_parser("python -m homing_gym.envcard", __doc__)
     parser.add_argument("out", nargs="?", default="docs/envs", help="output folder")
     args = parser.parse_args(argv)
     out = Path(args.out)
@@ -43,7 +44,8 @@ def main(argv: list[str] | None = None) -> None:
     for env_id in homing_gym.ENV_IDS:
         (out / card_filename(env_id)).write_text(env_card(env_id))
         print(f"wrote {out / card_filename(env_id)}")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -39,7 +39,6 @@ and writes ``longrange.json``.
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import sys
@@ -52,6 +51,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
+from homing_gym.cli import command_parser  # noqa: E402
 from homing_baselines.bearing_laws import LAWS  # noqa: E402
 from homing_baselines.bearing_sim import (ReachabilityMap, SimConfig, circumcircle,  # noqa: E402
                                    reachability_map, region)
@@ -472,7 +472,7 @@ def longrange(out: str, episodes: int = 10, seed: int = 0, route_length: float =
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="bearing-figures", description=__doc__.split("\n")[0])
+    parser = command_parser("python -m homing_train.figures.bearing", __doc__)
     sub = parser.add_subparsers(dest="command", required=True)
     rp = sub.add_parser("reachability", help="Fig. 4-style reachability maps of the three laws")
     rp.add_argument("--out", default="docs/bearing", help="output folder")

@@ -11,7 +11,6 @@ Sizes are the issue's: 200 LocalHoming episodes per setting, 20 routes per setti
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import json
 import math
@@ -24,6 +23,7 @@ import gymnasium as gym
 import numpy as np
 from tqdm import tqdm
 
+from homing_gym.cli import command_parser
 import homing_baselines
 import homing_gym
 from homing_baselines.snapshot import HongConfig, hong_homing
@@ -259,7 +259,7 @@ def markdown_tables(results: dict[str, Any]) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="hong-figures", description=__doc__.split("\n")[0])
+    parser = command_parser("python -m homing_train.figures.hong", __doc__)
     parser.add_argument("--out", default="docs/hong")
     parser.add_argument("--only", nargs="+", default=["sweep", "field", "eval", "route"],
                         choices=["signature", "sweep", "field", "eval", "route"])

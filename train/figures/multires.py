@@ -17,15 +17,16 @@ Ground truth (poses) is read here for measuring only; the controller sees observ
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
+import sys
 import time
 from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
 
+from homing_gym.cli import command_parser
 import homing_baselines
 import homing_gym
 from homing_baselines.multires import LOCALISE
@@ -129,8 +130,8 @@ def _cdf(ax, values, label):
     ax.step(v, np.arange(1, len(v) + 1) / len(v), where="post", label=label)
 
 
-def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+def main(argv: list[str] | None = None) -> int:
+    parser = command_parser("python -m homing_train.figures.multires", __doc__)
     parser.add_argument("experiment", choices=("localisation", "travel"))
     parser.add_argument("--out", default="docs/multires")
     parser.add_argument("--spacing", type=float, default=0.1, help="grid spacing (m)")
@@ -187,7 +188,8 @@ def main(argv: list[str] | None = None) -> None:
         ax.legend(fontsize=8)
         fig.tight_layout()
         fig.savefig(out / f"travel{tag}.png", dpi=110)
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

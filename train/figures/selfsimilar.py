@@ -37,7 +37,6 @@ median path length and shortest path of the successes, steps, collisions.
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import os
@@ -47,6 +46,7 @@ from typing import Sequence
 
 import numpy as np
 
+from homing_gym.cli import command_parser
 from homing_baselines.camera_models import PerspectiveModel
 from homing_baselines.selfsimilar_detector import DetectorConfig, detect_landmarks
 
@@ -348,8 +348,7 @@ def nav_table(merged: dict) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m homing_train.figures.selfsimilar",
-                                     description=__doc__.split("\n")[0])
+    parser = command_parser("python -m homing_train.figures.selfsimilar", __doc__)
     parser.add_argument("what", choices=["speed", "detection", "layout", "nav"])
     parser.add_argument("--runs", help="nav: folder of the chunked homing-eval results")
     parser.add_argument("--out", default="docs/selfsimilar")

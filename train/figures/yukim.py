@@ -31,7 +31,6 @@ Command line::
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import os
@@ -46,6 +45,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
+from homing_gym.cli import command_parser  # noqa: E402
 import homing_baselines  # noqa: E402
 import homing_gym  # noqa: E402,F401
 from homing_baselines.distance import (DistanceConfig, DistanceController, build_nest_map,  # noqa: E402
@@ -390,8 +390,7 @@ def plot_success(results: dict, trials: int, max_steps: int, path: str) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m homing_train.figures.yukim",
-                                     description=__doc__.split("\n")[0])
+    parser = command_parser("python -m homing_train.figures.yukim", __doc__)
     parser.add_argument("what", choices=("fields", "success", "eval"))
     parser.add_argument("--out", default="docs/yu_kim", help="output folder (eval: JSON path)")
     parser.add_argument("--grid", type=float, default=0.2, help="vector-map spacing (m)")

@@ -11,7 +11,6 @@ path); the scene of each shown episode is rebuilt with ``env.reset(seed)``.
 
 from __future__ import annotations
 
-import argparse
 import os
 import sys
 import warnings
@@ -25,6 +24,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from homing_gym.cli import command_parser  # noqa: E402
 from homing_gym.topdown import HOME, MapCanvas, draw_pose, draw_scene  # noqa: E402
 from homing_train.harness.evaluate import EvalResult  # noqa: E402
 
@@ -173,7 +173,7 @@ def compare(paths: Sequence[str], out: str, trajectories: int = 3) -> dict[str, 
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="homing-compare", description=__doc__.split("\n")[0])
+    parser = command_parser("homing-compare", __doc__)
     parser.add_argument("results", nargs="+", help="result JSON files of homing-eval")
     parser.add_argument("--out", required=True, help="output directory")
     parser.add_argument("--trajectories", type=int, default=3,

@@ -14,7 +14,7 @@ comparison of real methods is the job of ``homing-eval`` and ``homing-compare``.
 
 from __future__ import annotations
 
-import argparse
+import sys
 from pathlib import Path
 
 import gymnasium as gym
@@ -27,6 +27,7 @@ import numpy as np  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
 import homing_gym  # noqa: E402,F401
+from homing_gym.cli import command_parser  # noqa: E402
 from homing_gym.panorama import bearing_column  # noqa: E402
 from homing_train.harness.rollout import prepare_policy, rollout  # noqa: E402
 
@@ -81,9 +82,8 @@ def views_figure(env: gym.Env, seed: int, path: Path) -> None:
     plt.close(fig)
 
 
-def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description="write a demo episode of LocalHoming-v0 "
-                                                 "as PNG and GIF")
+def main(argv: list[str] | None = None) -> int:
+    parser = command_parser("homing-demo", __doc__)
     parser.add_argument("--out", default="demo", help="output folder")
     parser.add_argument("--seed", type=int, default=9)
     parser.add_argument("--scene", default="arena")
@@ -103,7 +103,8 @@ def main(argv: list[str] | None = None) -> None:
     outcome = "reached home" if info["is_success"] else "did not reach home"
     print(f"episode {args.seed}: {outcome} in {len(frames) - 1} steps, final distance "
           f"{info['distance_to_goal']:.3f} m; wrote {out}/demo.png, demo.gif, views.png")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -29,6 +29,7 @@ import numpy as np
 from tqdm import tqdm
 
 import homing_gym
+from homing_gym.cli import command_parser
 from homing_gym.paths import NoPathError, path_length, shortest_path
 from homing_gym.geometry import wrap_angle
 from homing_train.harness import metrics
@@ -334,7 +335,7 @@ def format_summary(result: EvalResult) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="homing-eval", description=__doc__.split("\n")[0])
+    parser = command_parser("homing-eval", __doc__)
     add_policy_arguments(parser)
     parser.add_argument("--episodes", type=int, default=100)
     parser.add_argument("--bin-width", type=float, default=0.3,

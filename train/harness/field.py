@@ -18,7 +18,6 @@ Command line (also ``python -m homing_train.harness.field``)::
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import os
@@ -34,6 +33,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from homing_gym.cli import command_parser  # noqa: E402
 from homing_gym.geometry import wrap_angle  # noqa: E402
 from homing_gym.scenes.base import clearance  # noqa: E402
 from homing_gym.topdown import HOME, MapCanvas, draw_pose, draw_scene  # noqa: E402
@@ -182,7 +182,7 @@ def plot_field(result: FieldResult, path: str, size: int = 480) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="homing-field", description=__doc__.split("\n")[0])
+    parser = command_parser("homing-field", __doc__)
     add_policy_arguments(parser)
     parser.add_argument("--scene", default=None, help="scene name (overrides --env-kwargs)")
     parser.add_argument("--grid", type=float, default=0.2, help="grid spacing (m)")

@@ -14,7 +14,6 @@ on the same seeded episodes (episode ``i`` uses seed ``seed + i``), writes one
 
 from __future__ import annotations
 
-import argparse
 import sys
 from dataclasses import dataclass
 from importlib import resources
@@ -23,6 +22,7 @@ from pathlib import Path
 import gymnasium as gym
 import yaml
 
+from homing_gym.cli import command_parser
 import homing_baselines
 import homing_gym  # noqa: F401  (registers the env ids)
 from homing_train.harness.compare import compare
@@ -92,11 +92,11 @@ def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: in
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="homing-suite", description=__doc__.split("\n")[0])
-    parser.add_argument("--env", default=DEFAULT_ENV)
-    parser.add_argument("--episodes", type=int, default=20)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--workers", type=int, default=2)
+    parser = command_parser("homing-suite", __doc__)
+    parser.add_argument("--env", default=DEFAULT_ENV, help="env id of the suite")
+    parser.add_argument("--episodes", type=int, default=20, help="episodes per method")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the first episode")
+    parser.add_argument("--workers", type=int, default=2, help="parallel processes")
     parser.add_argument("--methods", nargs="+", help="subset of methods (default: all)")
     parser.add_argument("--out", default="results", help="output folder (default: results)")
     args = parser.parse_args(argv)

@@ -14,13 +14,14 @@ without the training ``scene``, so the policy is scored in the env's default sce
 
 from __future__ import annotations
 
-import argparse
 import json
 import shutil
+import sys
 from pathlib import Path
 
 import yaml
 
+from homing_gym.cli import command_parser
 from homing_train.harness.suite import POLICY_DIR
 
 MAX_BYTES = 10 * 2**20
@@ -81,7 +82,7 @@ def ship_run(run: Path, name: str, folder: Path = POLICY_DIR, model: str = "best
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m homing_train.learning.ship", description=__doc__.split("\n")[0])
+    parser = command_parser("python -m homing_train.learning.ship", __doc__)
     parser.add_argument("run", type=Path, help="run folder written by homing-train")
     parser.add_argument("--name", required=True, help="name of the shipped policy")
     parser.add_argument("--model", choices=list(MODELS), default="best",
@@ -100,4 +101,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    sys.exit(main())

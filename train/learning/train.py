@@ -14,7 +14,6 @@ TensorBoard logs in ``tb/`` and ``learning_curve.png``.
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import platform
@@ -33,6 +32,7 @@ import numpy as np
 import yaml
 
 import homing_gym
+from homing_gym.cli import command_parser
 from homing_train.learning.extractor import EXTRACTORS, policy_kwargs_for
 from homing_train.learning.imitation import dagger
 from homing_train.learning.pretrain import pretrain
@@ -372,8 +372,8 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
     return model
 
 
-def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description="train PPO on a homing-gym env")
+def main(argv: list[str] | None = None) -> int:
+    parser = command_parser("homing-train", __doc__)
     parser.add_argument("--env", default="homing_gym/LocalHoming-v0")
     parser.add_argument("--out", help="run folder (default runs/<env>_<extractor>_s<seed>)")
     parser.add_argument("--resume", metavar="RUN", help="continue the run in this folder "
@@ -412,7 +412,8 @@ def main(argv: list[str] | None = None) -> None:
         parser.error(str(err))
     train(config, run, resume=bool(args.resume), progress=not args.no_progress)
     print(f"run folder: {run} ({json.loads((run / 'summary.json').read_text())})")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())
