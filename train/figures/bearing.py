@@ -51,10 +51,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
-from homing_gym.cli import command_parser  # noqa: E402
 from homing_baselines.bearing_laws import LAWS  # noqa: E402
 from homing_baselines.bearing_sim import (ReachabilityMap, SimConfig, circumcircle,  # noqa: E402
                                    reachability_map, region)
+from homing_gym.cli import command_parser  # noqa: E402
 
 #: The landmark triangle of the figures (m): scalene, about 2 m a side.
 LANDMARKS = np.array([[-1.0, -0.6], [1.2, -0.5], [0.2, 1.1]])

@@ -23,10 +23,10 @@ import gymnasium as gym
 import numpy as np
 from tqdm import tqdm
 
-from homing_gym.cli import command_parser
 import homing_baselines
 import homing_gym
 from homing_baselines.snapshot import HongConfig, hong_homing
+from homing_gym.cli import command_parser
 from homing_gym.geometry import bearing_to, wrap_angle
 from homing_gym.scenes.base import clearance
 from homing_train.harness.evaluate import evaluate

@@ -26,11 +26,11 @@ from pathlib import Path
 import gymnasium as gym
 import numpy as np
 
-from homing_gym.cli import command_parser
 import homing_baselines
 import homing_gym
 from homing_baselines.multires import LOCALISE
 from homing_baselines.multires_localise import localise
+from homing_gym.cli import command_parser
 from homing_gym.scenes.base import clearance
 from homing_gym.teaching import FeatureMap
 from homing_train.harness.rollout import prepare_policy, rollout

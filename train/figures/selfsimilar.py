@@ -46,9 +46,9 @@ from typing import Sequence
 
 import numpy as np
 
-from homing_gym.cli import command_parser
 from homing_baselines.camera_models import PerspectiveModel
 from homing_baselines.selfsimilar_detector import DetectorConfig, detect_landmarks
+from homing_gym.cli import command_parser
 
 #: Frames per second reported by the paper (§3.3) with the speed-ups.
 PAPER_FPS = {(640, 480): 36.0, (320, 240): 81.0}

@@ -35,7 +35,7 @@ import json
 import math
 import os
 import sys
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import gymnasium as gym
 import matplotlib
@@ -45,12 +45,12 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
-from homing_gym.cli import command_parser  # noqa: E402
 import homing_baselines  # noqa: E402
 import homing_gym  # noqa: E402,F401
-from homing_baselines.distance import (DistanceConfig, DistanceController, build_nest_map,  # noqa: E402
-                                distance_homing)
-from homing_baselines.warping import WarpingConfig, WarpingController, warping_homing  # noqa: E402
+from homing_baselines.distance import (DistanceConfig, DistanceController,  # noqa: E402
+                                       build_nest_map, distance_homing)
+from homing_baselines.warping import WarpingController, warping_homing  # noqa: E402
+from homing_gym.cli import command_parser  # noqa: E402
 from homing_gym.geometry import wrap_angle  # noqa: E402
 from homing_gym.scenes.base import clearance  # noqa: E402
 from homing_gym.topdown import HOME, MapCanvas, draw_pose, draw_scene  # noqa: E402

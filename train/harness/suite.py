@@ -22,9 +22,9 @@ from pathlib import Path
 import gymnasium as gym
 import yaml
 
-from homing_gym.cli import command_parser
 import homing_baselines
 import homing_gym  # noqa: F401  (registers the env ids)
+from homing_gym.cli import command_parser
 from homing_train.harness.compare import compare
 from homing_train.harness.evaluate import DEFAULT_ENV, evaluate, format_summary
 

@@ -39,6 +39,7 @@ def test_reaching_the_standing_pose_succeeds_and_facing_away_does_not(make_env):
     assert terminated and info["is_success"] and reward > 5
 
 
+@pytest.mark.slow
 def test_same_seed_same_episode_and_view(make_env):
     a = make_env(ENV_ID, obs_keys=("panorama", "goal_id", "view"), occlude_landmarks=0.5,
                  remove_landmarks=0.3)
@@ -52,6 +53,7 @@ def test_same_seed_same_episode_and_view(make_env):
         assert a.unwrapped.scene == b.unwrapped.scene
 
 
+@pytest.mark.slow
 def test_landmarks_are_removed_and_occluded_at_random(make_env):
     env = make_env(ENV_ID, remove_landmarks=0.5, occlude_landmarks=1.0)
     counts = set()

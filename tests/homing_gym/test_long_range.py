@@ -24,6 +24,7 @@ def _outbound(env, seed, actions):
     return np.array(poses), info
 
 
+@pytest.mark.slow
 def test_outbound_route_is_driven_by_the_env_and_ignores_the_agent(make_env):
     env = make_env(ENV_ID, route_length=2.0)
     still, info = _outbound(env, 5, lambda k: np.zeros(2, np.float32))

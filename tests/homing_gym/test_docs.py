@@ -7,7 +7,7 @@ import pytest
 import homing_gym
 from homing_gym.envcard import card_filename, env_card
 
-DOCS = Path(__file__).resolve().parents[1] / "docs" / "envs"
+DOCS = Path(__file__).resolve().parents[2] / "docs" / "envs"
 
 
 @pytest.mark.parametrize("env_id", homing_gym.ENV_IDS)

@@ -73,6 +73,7 @@ def test_pair_labels_turn_towards_the_oracle_waypoint(env):
     assert set(labels.tolist()) <= {FORWARD, LEFT, RIGHT}
 
 
+@pytest.mark.slow
 def test_pretraining_runs_from_homing_train_and_records_its_fit(tmp_path):
     run = tmp_path / "run"
     main(["--timesteps", "128", "--out", str(run), "--n-envs", "1", "--vec", "dummy",

@@ -52,12 +52,14 @@ def test_unified_law_reaches_goal_a_from_pixels_and_stops(lab):
     assert controller._unified.state.name == "BASIC"       # criterion 1: T in T^
 
 
+@pytest.mark.slow
 def test_unified_law_switches_to_complementary_for_goal_e(lab):
     record, controller = _run(lab, "bearing", (-2.0, 2.0, -1.0), "E")
     assert record.terminated and record.final_distance < 0.10
     assert controller._unified.state.name == "COMPLEMENTARY"
 
 
+@pytest.mark.slow
 def test_basic_law_fails_where_the_complementary_law_succeeds(lab):
     """Fig. 10: from a start in C^, goal E (rest of the plane) is unreachable for the
     basic law and reachable for the complementary law."""

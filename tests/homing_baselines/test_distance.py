@@ -12,7 +12,6 @@ from homing_baselines.distance import (DistanceConfig, DistanceController, Landm
                                 map_from_positions, resect_nest_map)
 from homing_baselines.landmarks_red import Arc
 from homing_gym.geometry import wrap_angle
-from test_warping import free_start
 
 LANDMARKS = np.array([(0.45, 0.35), (-0.35, 0.55), (-0.55, -0.25), (0.30, -0.50)])
 
@@ -148,7 +147,8 @@ def test_bad_parameters_raise():
         DistanceController(nest="elsewhere")
 
 
-def test_controller_reaches_home_from_1m_in_arena():
+@pytest.mark.slow
+def test_controller_reaches_home_from_1m_in_arena(free_start):
     """Four starts 1 m from a home near the arena centre, evenly spaced around it, with
     the paper's two-snapshot nest map (``goal_step``). Three of four must succeed: from
     the start towards the wall, only two landmarks get distances in both maps for

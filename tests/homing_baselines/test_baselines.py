@@ -2,14 +2,11 @@
 
 import math
 
-import gymnasium as gym
-import numpy as np
 import pytest
 
 import homing_baselines
 from homing_baselines.motion import MotionHelper, MotionSpec, Move, integrate
 from homing_train.harness.evaluate import run_episode
-from homing_train.harness.rollout import prepare_policy
 from homing_train.harness.policies import parse_params
 
 ENV_ID = "homing_gym/LocalHoming-v0"
@@ -92,26 +89,16 @@ def test_non_oracle_refuses_the_env():
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
-def test_oracle_reaches_home_and_stops_there(seed):
-    env = gym.make(ENV_ID, success_on="stop", max_episode_steps=300)
-    try:
-        oracle = homing_baselines.make("oracle")
-        prepare_policy(oracle, env)
-        record = run_episode(env, oracle, seed)
-    finally:
-        env.close()
+def test_oracle_reaches_home_and_stops_there(seed, make_env, controller_for):
+    env = make_env(ENV_ID, success_on="stop", max_episode_steps=300)
+    record = run_episode(env, controller_for("oracle", env), seed)
     assert record.success and record.terminated
     assert record.final_distance < 0.06
     assert record.final_heading_error_deg < 6.0
     assert record.path_length < 1.3 * record.shortest_path + 0.1
 
 
-def test_oracle_discrete_actions_reach_home():
-    env = gym.make(ENV_ID, action_type="discrete", max_episode_steps=300)
-    try:
-        oracle = homing_baselines.make("oracle")
-        prepare_policy(oracle, env)
-        record = run_episode(env, oracle, 4)
-    finally:
-        env.close()
+def test_oracle_discrete_actions_reach_home(make_env, controller_for):
+    env = make_env(ENV_ID, action_type="discrete", max_episode_steps=300)
+    record = run_episode(env, controller_for("oracle", env), 4)
     assert record.success and record.final_distance < 0.15

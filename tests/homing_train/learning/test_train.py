@@ -186,6 +186,7 @@ def test_stochastic_evaluation_of_a_model_is_reproducible_per_episode(tmp_path):
                  params={"deterministic": "maybe"})
 
 
+@pytest.mark.slow
 def test_imitation_fits_the_policy_to_the_oracle_labels(tmp_path):
     """DAgger's refit raises the policy's agreement with the oracle on the states it
     collected, and a run with imitation records it and then trains PPO as usual."""

@@ -1,5 +1,6 @@
 """close() frees the PyBullet client; repeated make/close does not leak."""
 
+import pytest
 import gc
 
 import gymnasium as gym
@@ -18,6 +19,7 @@ def test_close_disconnects_and_is_idempotent():
     env.close()
 
 
+@pytest.mark.slow
 def test_200_make_close_cycles_leak_nothing():
     rss = psutil.Process().memory_info().rss
     clients = []

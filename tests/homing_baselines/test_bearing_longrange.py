@@ -4,7 +4,6 @@ LongRangeHoming-v0."""
 
 import math
 
-import gymnasium as gym
 import numpy as np
 import pytest
 
@@ -12,7 +11,6 @@ import homing_baselines
 from homing_baselines.bearing_longrange import birth_frames, choose_milestones, median_offset
 from homing_baselines.klt import KLTConfig
 from homing_train.harness.evaluate import run_episode
-from homing_train.harness.rollout import prepare_policy
 
 
 def test_milestones_are_the_earliest_frames_sharing_enough_features():
@@ -42,16 +40,13 @@ def test_median_offset_is_robust_and_does_not_split_at_pi():
         median_offset(np.zeros(0))
 
 
-def test_longrange_homes_from_pixels_and_turns_to_the_home_heading():
-    env = gym.make("homing_gym/LongRangeHoming-v0", route_length=3.0, success_on="stop",
+@pytest.mark.slow
+def test_longrange_homes_from_pixels_and_turns_to_the_home_heading(make_env, controller_for):
+    env = make_env("homing_gym/LongRangeHoming-v0", route_length=3.0, success_on="stop",
                    max_episode_steps=900)
-    try:
-        controller = homing_baselines.make("bearing-longrange")
-        prepare_policy(controller, env)
-        record = run_episode(env, controller, seed=0)
-        outbound = env.unwrapped.task.outbound_steps
-    finally:
-        env.close()
+    controller = controller_for("bearing-longrange", env)
+    record = run_episode(env, controller, seed=0)
+    outbound = env.unwrapped.task.outbound_steps
     assert not controller.needs_env
     assert len(controller.memory) == outbound + 1          # every frame, then G
     assert controller.milestones[-1] == 0 and len(controller.milestones) >= 3

@@ -61,14 +61,12 @@ def test_template_found_at_its_subpixel_position_only_inside_the_window():
 
 @pytest.mark.parametrize("goal, start", [("kitchen", (5.5, 4.55, 0.1)),
                                          ("bedroom", (5.6, 1.45, -0.15))])
-def test_controller_stops_within_10_cm_of_a_work_location_from_1_m_away(make_env, goal, start):
-    import homing_baselines
+def test_controller_stops_within_10_cm_of_a_work_location_from_1_m_away(make_env, controller_for,
+                                                                        goal, start):
     from homing_train.harness.evaluate import run_episode
-    from homing_train.harness.rollout import prepare_policy
 
     env = make_env("homing_gym/WorkLocations-v0", goal_location=goal, max_episode_steps=200)
-    controller = homing_baselines.make("multires")
-    prepare_policy(controller, env)
+    controller = controller_for("multires", env)
     record = run_episode(env, controller, seed=0, start=start)
     assert record.terminated and record.success
     assert record.final_distance < 0.10

@@ -16,6 +16,7 @@ def test_a_policy_is_shipped_with_its_config_and_curve():
         assert shipped.path.with_name(f"{name}_curve.png").is_file(), name
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(SHIPPED))
 def test_shipped_policy_reaches_home_in_half_of_10_episodes(name):
     shipped = SHIPPED[name]

@@ -5,7 +5,6 @@ landmark in a small fake world (detections from geometry, exact odometry)."""
 import math
 from dataclasses import dataclass, field
 
-import gymnasium as gym
 import numpy as np
 import pytest
 
@@ -17,7 +16,6 @@ from homing_baselines.selfsimilar_panel import PanelPose
 from homing_gym.geometry import wrap_angle
 from homing_gym.tasks.landmark_navigation import N_IDS
 from homing_train.harness.evaluate import run_episode
-from homing_train.harness.rollout import prepare_policy
 
 
 def test_registered_with_its_observation_keys_and_checks_its_parameters():
@@ -35,20 +33,15 @@ def test_registered_with_its_observation_keys_and_checks_its_parameters():
                   "goal_id": np.eye(N_IDS, dtype=np.float32)[0]})
 
 
-def test_reaches_a_visible_goal_and_stops_in_front_of_it():
+def test_reaches_a_visible_goal_and_stops_in_front_of_it(make_env, controller_for):
     """Corridor, 2 m in front of panel 9 (east end wall), looking 70 degrees away from
     it: the robot must scan, find it, servo and stop in front of it
     (``success_on="stop"``: a success only if its own stop is in the success region)."""
-    env = gym.make("homing_gym/LandmarkNavigation-v0", success_on="stop",
+    env = make_env("homing_gym/LandmarkNavigation-v0", success_on="stop",
                    obs_keys=("view", "goal_id", "odometry"), max_episode_steps=250)
-    try:
-        env.reset(seed=5)
-        assert env.unwrapped.task.goal_id == 9
-        c = homing_baselines.make("selfsimilar")
-        prepare_policy(c, env)
-        record = run_episode(env, c, seed=5, start=[6.0, 3.0, 1.2])
-    finally:
-        env.close()
+    env.reset(seed=5)
+    assert env.unwrapped.task.goal_id == 9
+    record = run_episode(env, controller_for("selfsimilar", env), seed=5, start=[6.0, 3.0, 1.2])
     assert record.success and record.terminated
     assert record.path_length < 3.0
 

@@ -56,19 +56,6 @@ def arena():
     env.close()
 
 
-def free_start(env, home, distance, angle, heading, margin=0.25):
-    """The first start ``distance`` m from ``home`` at ``angle`` or counter-clockwise
-    beyond it (0.1 rad steps) with ``margin`` m of clearance: a valid start pose."""
-    from homing_gym.scenes.base import clearance
-
-    for k in range(63):
-        a = angle + 0.1 * k
-        xy = (home[0] + distance * math.cos(a), home[1] + distance * math.sin(a))
-        if clearance(env.unwrapped.scene, xy) >= margin:
-            return (*xy, heading)
-    raise AssertionError("no free start")
-
-
 def _render(env, pose):
     u = env.unwrapped
     u.sim.robot.set_pose(*pose)
@@ -95,7 +82,7 @@ def test_rendered_pairs_03m_apart_point_home(arena):
     assert max(errors) < 30, errors
 
 
-def test_controller_reaches_home_from_05m(arena):
+def test_controller_reaches_home_from_05m(arena, free_start):
     from homing_train.harness.evaluate import run_episode
     from homing_train.harness.rollout import prepare_policy
 

@@ -142,6 +142,7 @@ def test_compare_writes_table_and_pngs(tmp_path):
         assert (tmp_path / "cmp" / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+@pytest.mark.slow
 def test_field_of_oracle_points_home_and_random_does_not(tmp_path):
     out = tmp_path / "field.png"
     assert field_cli.main(["--policy", "oracle", "--grid", "0.6", "--quiet",

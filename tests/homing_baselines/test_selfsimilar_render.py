@@ -76,6 +76,7 @@ def test_corridors_scene_has_unique_barcoded_panels():
     assert ids == list(range(len(panels)))
 
 
+@pytest.mark.slow
 def test_corridors_visibility_graph_is_connected_on_rendered_scans():
     """From each room panel's standing place, a rendered scan (12 views, the controller's
     detector) finds a panel outside the room, from each corridor panel's another
