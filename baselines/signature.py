@@ -6,7 +6,7 @@ interval). On the default panorama width 360 the grid coincides with the column 
 (column ``x`` has bearing ``pi - 2*pi*x/W``, see :mod:`homing_gym.panorama`), so the
 panorama signature is a reordering of columns without interpolation.
 
-Two sources give the same signature (``tests/test_snapshot.py`` checks it):
+Two sources give the same signature (``tests/homing_baselines/test_snapshot.py`` checks it):
 
 * :func:`signature_from_omni`: §2 equation ``V_i = sum_{j=-2..2} I(i*dtheta, r_h + j*dr)``
   on the env's ``omni`` ring image (the paper's spherical-mirror view), ``r_h`` the

@@ -1,6 +1,6 @@
 """The panoramic camera: cylindrical panorama, catadioptric ring image, horizon signature.
 
-Conventions (tested in ``tests/test_panorama.py``):
+Conventions (tested in ``tests/homing_gym/test_panorama.py``):
 
 * Panorama: uint8 ``(H, W, 3)``, the full 360 degrees. The continuous column coordinate
   ``x`` runs over ``[0, W)``; pixel column ``j`` covers ``[j, j + 1)``, centre ``j + 0.5``.
@@ -175,7 +175,7 @@ def panorama_maps(config: CameraConfig, geom: ViewGeometry,
 
     ``pixel_centre`` is where the renderer samples pixel ``i``: at image coordinate
     ``i + pixel_centre``. TinyRenderer samples at ``i`` (0.0), OpenGL (EGL) at ``i + 0.5``;
-    both measured with the pole test of ``tests/test_panorama.py``.
+    both measured with the pole test of ``tests/homing_gym/test_panorama.py``.
     """
     H, W = config.panorama_shape
     beta = column_bearing(np.arange(W) + 0.5, W)[None, :].repeat(H, 0)

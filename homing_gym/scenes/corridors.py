@@ -45,7 +45,7 @@ DOORS_NORTH = (3.0, 5.0)
 #: see along the corridor. So every panel is reachable from every other one over the
 #: visibility graph (§4.1), as in the paper's environment, where landmarks are seen from
 #: room to corridor and along it (checked on rendered views by
-#: ``python -m homing_train.figures.selfsimilar layout`` and ``tests/test_selfsimilar_render.py``).
+#: ``python -m homing_train.figures.selfsimilar layout`` and ``tests/homing_baselines/test_selfsimilar_render.py``).
 PANELS = (
     (0, 1.4, 0.0, 90), (1, 2.6, 0.0, 90),          # room A (south-west)
     (2, 5.5, 0.0, 90), (3, 6.7, 0.0, 90),          # room B (south-east)

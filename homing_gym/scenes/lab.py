@@ -20,7 +20,8 @@ else in the room is strongly saturated in the three poster hues
   ``A`` inside the landmark triangle ``T^``, ``F`` in ``C^ - T^`` (inside the circle
   through the landmarks, outside the triangle), ``C`` and ``D`` in ``H^`` (behind
   ``L1`` and ``L2``), ``B`` and ``E`` in the rest of the plane. Each lies at least
-  0.2 m from the boundaries of its region (``tests/test_lab_scene.py`` checks with
+  0.2 m from the boundaries of its region
+  (``tests/homing_baselines/test_bearing_controllers.py`` checks with
   :func:`homing_baselines.bearing_sim.region`).
 """
 

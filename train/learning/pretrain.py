@@ -5,7 +5,7 @@ Rolling out episodes to collect imitation data costs a physics step and a render
 sample and gives strongly correlated samples (about 100 per second here). This module gets
 them from a *bank* of panoramas instead. A cylindrical panorama taken at heading ``theta``
 is the panorama taken at heading 0 at the same place, rolled by ``theta * W / (2 pi)``
-columns towards higher column indices (``tests/test_pretrain.py`` checks this on rendered
+columns towards higher column indices (``tests/homing_train/learning/test_pretrain.py`` checks this on rendered
 panoramas). So ``N`` panoramas rendered at heading 0 at free floor positions give
 ``N^2 W^2`` pairs (current view at position ``i`` and heading ``k``, goal view at position
 ``j`` and heading ``m``). Each pair is labelled with the oracle's action from pose
