@@ -14,8 +14,8 @@ configuration, in the same run:
 
 from __future__ import annotations
 
-import sys
 import json
+import sys
 import time
 from dataclasses import asdict, dataclass
 
@@ -26,10 +26,14 @@ from tqdm import tqdm
 import homing_gym  # noqa: F401  (registers the envs)
 from homing_gym.cli import command_parser
 
-CONFIGS = {
-    "default": {},
-    "W=360": {"panorama_shape": (60, 360)},
-}
+#: Panorama shapes measured, (H, W) pixels.
+SHAPES = {"48x256": (48, 256), "60x360": (60, 360), "120x720": (120, 720)}
+
+
+def configs(renderers: list[str], shapes: list[str]) -> dict[str, dict]:
+    """Env kwargs of each measured configuration, named ``RENDERER HxW``."""
+    return {f"{r} {s}": {"renderer": r, "panorama_shape": SHAPES[s]}
+            for s in shapes for r in renderers}
 
 
 @dataclass
@@ -99,12 +103,18 @@ def run_config(name: str, env_kwargs: dict, steps: int, workers: int, rounds: in
 
 
 def format_table(results: list[BenchmarkResult]) -> str:
-    """A Markdown table of the results."""
-    lines = ["| config | render (pano/s) | env (steps/s) | env / render time | "
-             "AsyncVectorEnv (steps/s) |", "|---|---|---|---|---|"]
+    """A Markdown table of the results; ``env vs tiny``: env steps/s over those of
+    ``renderer="tiny"`` at the same shape in the same run."""
+    tiny = {tuple(r.env_kwargs["panorama_shape"]): r.env_steps_per_s for r in results
+            if r.env_kwargs.get("renderer") == "tiny"}
+    lines = ["| config | render (pano/s) | env (steps/s) | env vs tiny | env / render time | "
+             "AsyncVectorEnv (steps/s) |", "|---|---|---|---|---|---|"]
     for r in results:
+        ref = tiny.get(tuple(r.env_kwargs["panorama_shape"]))
+        versus = f"{r.env_steps_per_s / ref:.2f}x" if ref else "-"
         lines.append(f"| {r.config} | {r.render_per_s:.1f} | {r.env_steps_per_s:.1f} | "
-                     f"{r.ratio:.3f} | {r.vector_steps_per_s:.1f} ({r.workers} workers) |")
+                     f"{versus} | {r.ratio:.3f} | {r.vector_steps_per_s:.1f} "
+                     f"({r.workers} workers) |")
     return "\n".join(lines)
 
 
@@ -112,12 +122,16 @@ def main(argv: list[str] | None = None) -> int:
     parser = command_parser("homing-benchmark", __doc__)
     parser.add_argument("--steps", type=int, default=500, help="steps per measurement")
     parser.add_argument("--workers", type=int, default=2, help="AsyncVectorEnv workers")
+    parser.add_argument("--renderers", nargs="+", default=["tiny", "raycast"],
+                        choices=["tiny", "raycast", "egl"], help="renderers to compare")
+    parser.add_argument("--shapes", nargs="+", default=list(SHAPES), choices=list(SHAPES),
+                        help="panorama shapes (H x W)")
     parser.add_argument("--json", help="also write the results to this JSON file")
     args = parser.parse_args(argv)
     if args.steps < 10 or args.workers < 1:
         parser.error("need --steps >= 10 and --workers >= 1")
     results = [run_config(name, kwargs, args.steps, args.workers)
-               for name, kwargs in CONFIGS.items()]
+               for name, kwargs in configs(args.renderers, args.shapes).items()]
     print(format_table(results))
     if args.json:
         with open(args.json, "w") as f:

@@ -102,8 +102,9 @@ class HomingEnv(gym.Env):
         self.sim = Simulator(self.scene, gui=render_mode == "human",
                              time_step=self.control_period / self.physics_substeps,
                              robot_config=self.robot_config, renderer=renderer)
-        self.camera = PanoramaCamera(camera_config, self.robot_config.camera_height,
-                                     renderer=self.sim.renderer)
+        self.camera = PanoramaCamera(
+            camera_config, self.robot_config.camera_height, renderer=self.sim.renderer,
+            caster=(lambda: self.sim.caster) if self.sim.caster is not None else None)
 
         self._table = {k: table[k] for k in self.obs_keys}
         self.observation_space = spaces.Dict(
@@ -166,7 +167,7 @@ class HomingEnv(gym.Env):
         config = PerspectiveConfig(width=size[0], height=size[1], hfov=math.radians(hfov_deg))
         return render_perspective(self.sim.client, self.pose if pose is None else pose,
                                   self.robot_config.camera_height, config,
-                                  self.sim.renderer, self._lighting)
+                                  self.sim.renderer, self._lighting, self.sim.caster)
 
     @property
     def goal_pose(self) -> np.ndarray:

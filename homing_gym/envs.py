@@ -98,7 +98,8 @@ class LocalHomingEnv(HomingEnv):
     ``"random_arena"`` or a :class:`~homing_gym.scenes.Scene`), ``render_mode``
     (``None``, ``"rgb_array"``: top-down map beside current and goal panoramas;
     ``"human"``: PyBullet GUI), ``obs_keys``, ``panorama_shape`` = (48, 256),
-    ``vfov_deg`` = 60, ``n_views`` = 6, ``renderer`` (``"tiny"`` or ``"egl"``), ``omni_size`` = 128,
+    ``vfov_deg`` = 60, ``n_views`` = 6, ``renderer`` (``"tiny"``, ``"egl"`` or ``"raycast"``: Embree ray casting, one ray
+    per pixel centre, see :mod:`homing_gym.raycast`), ``omni_size`` = 128,
     ``action_type``, ``control_period``, ``physics_substeps``, ``max_speed``,
     ``max_yaw_rate``, ``stop_threshold``, ``odometry_noise`` = 0.02, ``goal_step_length`` = 0.15,
     ``lighting_change`` = 0

@@ -40,7 +40,7 @@ from pybullet_utils.bullet_client import BulletClient
 
 from homing_gym.vision import horizon_line
 
-RENDERERS = ("tiny", "egl")
+RENDERERS = ("tiny", "egl", "raycast")
 OMNI_INNER, OMNI_OUTER = 0.25, 0.98
 
 
@@ -233,8 +233,12 @@ class PanoramaCamera:
     """Renders panoramas at a robot pose and derives the ``omni`` and ``signature`` views."""
 
     def __init__(self, config: CameraConfig = CameraConfig(), camera_height: float = 0.30,
-                 renderer: int = p.ER_TINY_RENDERER):
+                 renderer: int = p.ER_TINY_RENDERER, caster=None):
+        """``renderer``: PyBullet's renderer for the perspective views; ``caster``: a
+        callable returning the simulator's current
+        :class:`~homing_gym.raycast.RayCaster`, which then renders instead."""
         self.config = config
+        self.caster = caster
         self.camera_height = camera_height
         self.renderer = renderer
         self.geometry = view_geometry(config)
@@ -274,6 +278,8 @@ class PanoramaCamera:
     def render(self, client: BulletClient, pose, lighting: Lighting | None = None) -> np.ndarray:
         """Panorama at ``pose = (x, y, yaw)`` (metres, radians): uint8 ``(H, W, 3)``,
         under ``lighting`` (``None``: the default lighting)."""
+        if self.caster is not None:
+            return self.caster().panorama(pose, self.camera_height, self.config, lighting)
         views = self.render_views(client, pose, lighting or DEFAULT_LIGHTING)
         pano = cv2.remap(views, self._map_x, self._map_y, cv2.INTER_LINEAR,
                          borderMode=cv2.BORDER_REPLICATE)

@@ -60,10 +60,15 @@ class PerspectiveConfig:
 def render_perspective(client: BulletClient, pose, camera_height: float,
                        config: PerspectiveConfig = PerspectiveConfig(),
                        renderer: int = p.ER_TINY_RENDERER,
-                       lighting: Lighting | None = None) -> np.ndarray:
+                       lighting: Lighting | None = None, caster=None) -> np.ndarray:
     """The view from ``pose = (x, y, yaw)`` (metres, radians) at ``camera_height``
     metres: uint8 ``(height, width, 3)``. ``lighting`` as for the panorama (``None``:
-    the default), including its brightness/contrast change."""
+    the default), including its brightness/contrast change. With a ``caster``
+    (:class:`~homing_gym.raycast.RayCaster`) the view is ray cast through pixel centres
+    (``c = 0.5``) instead of rendered by PyBullet."""
+    if caster is not None:
+        return caster.perspective(pose, camera_height, config.width, config.height,
+                                  config.focal, lighting)
     light = lighting or DEFAULT_LIGHTING
     x, y, yaw = float(pose[0]), float(pose[1]), float(pose[2])
     eye = [x, y, camera_height]

@@ -24,9 +24,11 @@ import pybullet as p
 from pybullet_utils.bullet_client import BulletClient
 
 from homing_gym.native_output import native_output_captured
+from homing_gym.raycast import RayCaster
 from homing_gym.robot import Robot, RobotConfig
 from homing_gym.scenes.base import Landmark, Scene, Wall
 from homing_gym.textures import texture_path
+from homing_gym.worldmesh import world_mesh
 
 FLOOR_MARGIN = 2.0
 
@@ -42,6 +44,8 @@ class Simulator:
         c = self.client
         # the EGL plugin only sees bodies created after it is loaded: load it first
         self.renderer = load_egl(c) if renderer == "egl" else p.ER_TINY_RENDERER
+        #: The ray caster of the current world (``renderer="raycast"``), else None.
+        self.caster = RayCaster(world_mesh(scene)) if renderer == "raycast" else None
         c.setGravity(0, 0, -9.81)
         c.setTimeStep(time_step)
         c.setPhysicsEngineParameter(deterministicOverlappingPairs=1, numSolverIterations=10)
@@ -178,6 +182,8 @@ class Simulator:
         self._state = c.saveState()
         self.obstacle_ids = frozenset(self.wall_ids + self.landmark_ids)
         self.scene = scene
+        if self.caster is not None:
+            self.caster = RayCaster(world_mesh(scene))
 
     def place_robot(self, pose, clear_contacts: bool = False) -> None:
         """Teleport the robot to ``pose`` (x, y, yaw; metres, radians). With

@@ -6,6 +6,7 @@ The PNGs in ``homing_gym/assets/textures`` are produced deterministically by
 
 from __future__ import annotations
 
+from functools import lru_cache
 from importlib import resources
 from pathlib import Path
 
@@ -29,6 +30,19 @@ def texture_path(texture: str) -> str:
     raise ValueError(
         f"unknown texture {texture!r}; allowed: a path to a .png file or one of "
         f"{available_textures()}")
+
+
+@lru_cache(maxsize=256)
+def load_texture(texture: str) -> np.ndarray:
+    """The texture's pixels, uint8 RGB ``(h, w, 3)``, row 0 at the top (cached; treat as
+    read-only)."""
+    path = texture_path(texture)
+    image = cv2.imread(path, cv2.IMREAD_COLOR)
+    if image is None:
+        raise ValueError(f"texture {texture!r}: {path} is not a readable image")
+    rgb = cv2.cvtColor(image, cv2.COLOR_BGR2RGB)
+    rgb.setflags(write=False)
+    return rgb
 
 
 def check_texture(texture: str) -> None:

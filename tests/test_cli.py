@@ -19,6 +19,7 @@ COMMANDS = {
     "python -m homing_train.figures.bearing": "homing_train.figures.bearing",
     "python -m homing_train.figures.selfsimilar": "homing_train.figures.selfsimilar",
     "python -m homing_train.figures.multires": "homing_train.figures.multires",
+    "python -m homing_train.figures.renderers": "homing_train.figures.renderers",
     "python -m homing_train.learning.ship": "homing_train.learning.ship",
     "python -m homing_gym.envcard": "homing_gym.envcard",
 }

@@ -1,0 +1,152 @@
+"""A scene as one set of textured triangles: what the ray-cast renderer sees.
+
+:func:`world_mesh` turns a :class:`~homing_gym.scenes.base.Scene` into triangles with the
+same placement as the PyBullet bodies of :class:`~homing_gym.simulator.Simulator` (floor
+top face, walls and box landmarks as boxes, cylinders as 64-sided prisms, panels as boxes
+whose front face carries the texture once). Each triangle has a colour (RGB in
+``[0, 1]``), a texture index (``-1``: none) and texture coordinates per corner: ``u``
+left to right, ``v`` bottom to top, each box side and the floor covered by its texture
+once, a cylinder's side wrapped once around. The texture colour is multiplied by the
+body colour, as PyBullet does.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from homing_gym.scenes.base import Landmark, Scene
+from homing_gym.textures import load_texture
+
+#: Sides of the prism that stands for a cylinder: the silhouette is within
+#: ``r (1 - cos(pi/64))`` = 0.1 % of the radius of the true circle.
+CYLINDER_SIDES = 64
+#: Margin (metres) of the floor beyond the scene bounds, as in the simulator.
+FLOOR_MARGIN = 2.0
+
+
+@dataclass
+class WorldMesh:
+    """``triangles`` ``(N, 3, 3)`` float32 corners (metres); ``colors`` ``(N, 3)``;
+    ``texture`` ``(N,)`` index into ``textures`` or ``-1``; ``uvs`` ``(N, 3, 2)``;
+    ``textures``: float32 RGB images in ``[0, 1]``, row 0 at the top."""
+
+    triangles: np.ndarray
+    colors: np.ndarray
+    texture: np.ndarray
+    uvs: np.ndarray
+    textures: list[np.ndarray]
+
+    @property
+    def normals(self) -> np.ndarray:
+        """Unit face normals ``(N, 3)`` (orientation arbitrary; shading is two-sided)."""
+        n = np.cross(self.triangles[:, 1] - self.triangles[:, 0],
+                     self.triangles[:, 2] - self.triangles[:, 0])
+        return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
+
+
+class _Builder:
+    """Collects quads and triangles with their materials."""
+
+    def __init__(self) -> None:
+        self.tris: list[np.ndarray] = []
+        self.colors: list[np.ndarray] = []
+        self.tex: list[int] = []
+        self.uvs: list[np.ndarray] = []
+        self.textures: list[np.ndarray] = []
+        self._texture_ids: dict[str, int] = {}
+
+    def texture_id(self, name: str | None) -> int:
+        if name is None:
+            return -1
+        if name not in self._texture_ids:
+            self._texture_ids[name] = len(self.textures)
+            self.textures.append(load_texture(name).astype(np.float32) / 255.0)
+        return self._texture_ids[name]
+
+    def quad(self, corners, uv, color, tex: int) -> None:
+        """Corners in order around the quad (any winding); ``uv`` per corner."""
+        c, t = np.asarray(corners, np.float64), np.asarray(uv, np.float64)
+        for i, j, k in ((0, 1, 2), (0, 2, 3)):
+            self.tris.append(c[[i, j, k]])
+            self.uvs.append(t[[i, j, k]])
+            self.colors.append(np.asarray(color[:3], np.float64))
+            self.tex.append(tex)
+
+    def box(self, centre, half, yaw: float, color, tex: int, front_only_uv: bool = False) -> None:
+        """A box; every side textured once (``front_only_uv``: only the local +y side,
+        the others take the texture's top-left texel, like a panel)."""
+        hx, hy, hz = half
+        rot = np.array([[math.cos(yaw), -math.sin(yaw), 0], [math.sin(yaw), math.cos(yaw), 0],
+                        [0, 0, 1]])
+        corner_uv = [(0.001, 0.999)] * 4
+
+        def world(p):
+            return np.asarray(centre) + rot @ np.asarray(p, np.float64)
+
+        sides = {  # (corners bottom-left, bottom-right, top-right, top-left as seen from out)
+            "+y": [(hx, hy, -hz), (-hx, hy, -hz), (-hx, hy, hz), (hx, hy, hz)],
+            "-y": [(-hx, -hy, -hz), (hx, -hy, -hz), (hx, -hy, hz), (-hx, -hy, hz)],
+            "+x": [(hx, -hy, -hz), (hx, hy, -hz), (hx, hy, hz), (hx, -hy, hz)],
+            "-x": [(-hx, hy, -hz), (-hx, -hy, -hz), (-hx, -hy, hz), (-hx, hy, hz)],
+            "+z": [(-hx, -hy, hz), (hx, -hy, hz), (hx, hy, hz), (-hx, hy, hz)],
+            "-z": [(-hx, hy, -hz), (hx, hy, -hz), (hx, -hy, -hz), (-hx, -hy, -hz)],
+        }
+        full = [(0, 0), (1, 0), (1, 1), (0, 1)]
+        for name, corners in sides.items():
+            uv = full if (not front_only_uv or name == "+y") else corner_uv
+            self.quad([world(p) for p in corners], uv, color, tex)
+
+    def cylinder(self, centre, radius: float, height: float, yaw: float, color,
+                 tex: int) -> None:
+        a = yaw + np.linspace(0, 2 * math.pi, CYLINDER_SIDES + 1)
+        x, y = centre[0] + radius * np.cos(a), centre[1] + radius * np.sin(a)
+        z0, z1 = centre[2] - height / 2, centre[2] + height / 2
+        u = np.linspace(0, 1, CYLINDER_SIDES + 1)
+        for k in range(CYLINDER_SIDES):
+            self.quad([(x[k], y[k], z0), (x[k + 1], y[k + 1], z0), (x[k + 1], y[k + 1], z1),
+                       (x[k], y[k], z1)], [(u[k], 0), (u[k + 1], 0), (u[k + 1], 1), (u[k], 1)],
+                      color, tex)
+            for z in (z0, z1):
+                tri = np.array([(centre[0], centre[1], z), (x[k], y[k], z),
+                                (x[k + 1], y[k + 1], z)])
+                self.tris.append(tri)
+                self.uvs.append(np.full((3, 2), 0.001))
+                self.colors.append(np.asarray(color[:3], np.float64))
+                self.tex.append(tex)
+
+    def mesh(self) -> WorldMesh:
+        return WorldMesh(np.array(self.tris, np.float32), np.array(self.colors, np.float32),
+                         np.array(self.tex, np.int32), np.array(self.uvs, np.float32),
+                         self.textures)
+
+
+def _landmark(b: _Builder, lm: Landmark) -> None:
+    centre = (lm.position[0], lm.position[1], lm.base + lm.height / 2)
+    tex = b.texture_id(lm.texture)
+    if lm.shape == "cylinder":
+        b.cylinder(centre, lm.radius, lm.height, lm.yaw, lm.color, tex)
+    else:
+        half = (lm.extent[0] / 2, lm.extent[1] / 2, lm.height / 2)
+        b.box(centre, half, lm.yaw, lm.color, tex, front_only_uv=lm.shape == "panel")
+
+
+def world_mesh(scene: Scene) -> WorldMesh:
+    """The triangles of ``scene``'s floor, walls and landmarks (see the module doc)."""
+    b = _Builder()
+    (xmin, ymin), (xmax, ymax) = scene.bounds
+    x0, x1 = xmin - FLOOR_MARGIN, xmax + FLOOR_MARGIN
+    y0, y1 = ymin - FLOOR_MARGIN, ymax + FLOOR_MARGIN
+    b.quad([(x0, y0, 0.0), (x1, y0, 0.0), (x1, y1, 0.0), (x0, y1, 0.0)],
+           [(0, 0), (1, 0), (1, 1), (0, 1)], scene.floor_color,
+           b.texture_id(scene.floor_texture))
+    for wall in scene.walls:
+        (wx0, wy0), (wx1, wy1) = wall.start, wall.end
+        b.box(((wx0 + wx1) / 2, (wy0 + wy1) / 2, wall.height / 2),
+              ((wall.length + wall.thickness) / 2, wall.thickness / 2, wall.height / 2),
+              math.atan2(wy1 - wy0, wx1 - wx0), wall.color, b.texture_id(wall.texture))
+    for lm in scene.landmarks:
+        _landmark(b, lm)
+    return b.mesh()

@@ -1,0 +1,131 @@
+"""The ray-cast renderer: geometry against known truth, agreement with TinyRenderer."""
+
+import math
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+from homing_gym.panorama import bearing_column
+from homing_gym.perspective import PerspectiveConfig
+from homing_gym.scenes import Landmark, Scene, available_scenes
+from homing_gym.vision import luminance
+
+pytest.importorskip("embreex")
+
+RED = (0.9, 0.05, 0.05, 1.0)
+
+
+def _pole_scene(x: float, y: float) -> Scene:
+    return Scene("pole", bounds=((-3, -3), (3, 3)), walls=(),
+                 landmarks=(Landmark((x, y), radius=0.05, height=2.0, color=RED),))
+
+
+def _red_column(image: np.ndarray, row: int) -> float:
+    """Continuous column of the red pole's centre in ``row`` (weighted by redness)."""
+    line = image[row].astype(float)
+    redness = np.clip(line[:, 0] - line[:, 1:].mean(1), 0, None)
+    redness[redness < 20] = 0
+    cols = np.nonzero(redness)[0]
+    assert len(cols), "pole not in view"
+    return float((cols + 0.5) @ redness[cols] / redness[cols].sum())
+
+
+@pytest.mark.parametrize("supersampling, median, worst", [(1, 0.5, 0.5), (4, 0.25, 0.5)])
+def test_pole_bearings_match_the_geometry(supersampling, median, worst):
+    """One ray per pixel puts a pole's centre within half a column (the covered columns'
+    centres); 4 x 4 rays per pixel give fractional coverage, a quarter column."""
+    errors = []
+    rng = np.random.default_rng(0)
+    for _ in range(12):
+        a, d = rng.uniform(-math.pi, math.pi), rng.uniform(1.0, 2.5)
+        x, y = d * math.cos(a), d * math.sin(a)
+        env = gym.make("homing_gym/LocalHoming-v0", scene=_pole_scene(x, y),
+                       renderer="raycast", panorama_shape=(48, 360), start_distance=(0.3, 0.5))
+        env.reset(seed=0)
+        u = env.unwrapped
+        yaw = rng.uniform(-math.pi, math.pi)
+        pano = u.sim.caster.panorama([0.0, 0.0, yaw], u.robot_config.camera_height,
+                                     u.camera.config, supersampling=supersampling)
+        env.close()
+        truth = float(bearing_column(math.atan2(y, x) - yaw, 360))
+        got = _red_column(pano, 24)
+        errors.append(abs((got - truth + 180) % 360 - 180))
+    assert np.median(errors) <= median and max(errors) <= worst, errors
+
+
+def test_elevation_of_the_pole_top_matches_the_geometry():
+    env = gym.make("homing_gym/LocalHoming-v0", scene=Scene(
+        "low_pole", bounds=((-3, -3), (3, 3)), walls=(),
+        landmarks=(Landmark((1.0, 0.0), radius=0.03, height=0.5, color=RED),)),
+        renderer="raycast", panorama_shape=(120, 256), start_distance=(0.3, 0.5))
+    env.reset(seed=0)
+    pano = env.unwrapped.render_panorama(np.array([0.0, 0.0, 0.0]))
+    env.close()
+    column = pano[:, 128].astype(float)
+    red_rows = np.nonzero(column[:, 0] - column[:, 1:].mean(1) > 40)[0]
+    # the pole's top edge: 0.5 m high, 0.2 m above the camera, front face 0.97 m away
+    top = math.atan2(0.5 - 0.30, 1.0 - 0.03)
+    expected_row = (math.radians(30) - top) / math.radians(60) * 120
+    assert abs(red_rows.min() - expected_row) <= 1.0
+
+
+def test_the_same_pose_gives_identical_pixels():
+    env = gym.make("homing_gym/LocalHoming-v0", scene="house", renderer="raycast")
+    env.reset(seed=1)
+    u = env.unwrapped
+    a = u.render_panorama(u.pose)
+    b = u.render_panorama(u.pose)
+    env.close()
+    assert np.array_equal(a, b)
+
+
+def test_perspective_view_puts_the_pole_where_the_pinhole_does():
+    env = gym.make("homing_gym/LocalHoming-v0", scene=_pole_scene(2.0, 0.5),
+                   renderer="raycast", start_distance=(0.3, 0.5))
+    env.reset(seed=0)
+    view = env.unwrapped.render_view(pose=np.array([0.0, 0.0, 0.0]), size=(320, 240))
+    env.close()
+    config = PerspectiveConfig(320, 240)
+    expected = 160 - config.focal * 0.5 / 2.0          # column coordinate of the axis
+    assert abs(_red_column(view, 120) - expected) <= 0.5
+
+
+@pytest.mark.parametrize("scene", sorted(set(available_scenes())))
+def test_raycast_and_tinyrenderer_agree_on_bearings(scene):
+    """The column structure (horizontal luminance edges, summed over rows) of both
+    renderers' panoramas at the same pose lines up to within one column; shading
+    differs (PyBullet's box texture coordinates and its lighting model are not copied)."""
+    images = []
+    for renderer in ("tiny", "raycast"):
+        env = gym.make("homing_gym/LocalHoming-v0", scene=scene, renderer=renderer,
+                       panorama_shape=(48, 256), start_distance=(0.3, 0.8))
+        env.reset(seed=2)
+        u = env.unwrapped
+        images.append(u.render_panorama(u.pose))
+        env.close()
+    edges = [np.abs(np.diff(luminance(im), axis=1, append=luminance(im)[:, :1])).sum(0)
+             for im in images]
+    a, b = (e - e.mean() for e in edges)
+    scores = [float(np.dot(a, np.roll(b, s))) for s in range(-8, 9)]
+    assert abs(int(np.argmax(scores)) - 8) <= 1
+    diff = np.abs(images[0].astype(int) - images[1].astype(int)).mean()
+    print(f"{scene}: mean absolute difference {diff:.1f} grey levels")
+
+
+def test_without_embreex_raycast_is_a_clear_error(monkeypatch):
+    import builtins
+
+    real_import = builtins.__import__
+
+    def no_embreex(name, *args, **kwargs):
+        if name.startswith("embreex"):
+            raise ImportError("No module named 'embreex'")
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", no_embreex)
+    with pytest.raises(ValueError, match=r'embreex.*renderer="tiny"'):
+        gym.make("homing_gym/LocalHoming-v0", renderer="raycast")
+    env = gym.make("homing_gym/LocalHoming-v0", renderer="tiny", panorama_shape=(16, 64))
+    env.reset(seed=0)
+    env.close()
