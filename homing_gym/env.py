@@ -24,7 +24,7 @@ from homing_gym.perspective import PerspectiveConfig, render_perspective
 from homing_gym.robot import RobotConfig, WheelOdometry
 from homing_gym.scenes import scene_factory
 from homing_gym.scenes.base import Scene
-from homing_gym.simulator import Simulator
+from homing_gym.simulator import Simulator, gui_unavailable
 from homing_gym.tasks.base import Task
 from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.episode import Episode
@@ -61,6 +61,9 @@ class HomingEnv(gym.Env):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"unknown render_mode {render_mode!r}; allowed: "
                              f"{self.metadata['render_modes']} or None")
+        if render_mode == "human" and (why := gui_unavailable()):
+            raise ValueError(f"render_mode='human' opens PyBullet's GUI, which cannot open "
+                             f"here: {why}; use render_mode='rgb_array' (frames as arrays)")
         if action_type not in ACTION_TYPES:
             raise ValueError(f"unknown action_type {action_type!r}; allowed: {ACTION_TYPES}")
         if not (isinstance(physics_substeps, (int, np.integer)) and physics_substeps >= 1):
@@ -220,21 +223,28 @@ class HomingEnv(gym.Env):
         return views
 
     def _command(self, action) -> tuple[float, float, bool]:
-        """Validated action -> (forward, yaw) in normalised units and the stop flag."""
+        """Validated action -> (forward, yaw) in normalised units and the stop flag.
+        Real numbers only: booleans, complex numbers, strings and ``None`` are refused."""
+        a = np.asarray(action, dtype=object if action is None else None)
+        mixed_bools = isinstance(action, (list, tuple)) and any(
+            isinstance(x, (bool, np.bool_)) for x in action)
+        real = a.dtype.kind in "iuf" and not mixed_bools
         if self.action_type == "discrete":
-            if not (np.ndim(action) == 0 and float(action) == int(action)
-                    and int(action) in iter(DiscreteAction)):
-                names = ", ".join(f"{a.value} {a.name.lower()}" for a in DiscreteAction)
-                raise ValueError(f"action {action!r} is not one of {names}")
-            chosen = DiscreteAction(int(action))
+            if not (real and a.ndim == 0 and np.isfinite(a) and float(a).is_integer()
+                    and int(a) in iter(DiscreteAction)):
+                names = ", ".join(f"{d.value} {d.name.lower()}" for d in DiscreteAction)
+                raise ValueError(f"discrete action {action!r} is not one of {names}")
+            chosen = DiscreteAction(int(a))
             v, w = chosen.command
             return v, w, chosen is DiscreteAction.STOP
-        a = np.asarray(action, dtype=np.float64)
+        if not real:
+            raise ValueError(f"action {action!r} must be two real numbers (forward, yaw rate) "
+                             f"in [-1, 1]; got {a.dtype.name} values")
         if a.shape != (2,):
             raise ValueError(f"action {action!r} must have shape (2,) = (forward, yaw rate)")
         if not np.all(np.isfinite(a)):
             raise ValueError(f"action {action!r} contains NaN or infinity")
-        v, w = np.clip(a, -1.0, 1.0)
+        v, w = np.clip(a.astype(np.float64), -1.0, 1.0)
         stop = abs(v) < self.stop_threshold and abs(w) < self.stop_threshold
         return float(v), float(w), bool(stop)
 
@@ -288,6 +298,7 @@ class HomingEnv(gym.Env):
 
     # -- Gymnasium API --------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
+        self._check_open()
         super().reset(seed=seed)
         if self._scene_factory.randomised:
             self.scene = self._scene_factory.build(self.np_random)
@@ -310,6 +321,7 @@ class HomingEnv(gym.Env):
         return self._observation(), self._info()
 
     def step(self, action):
+        self._check_open()
         if self.episode is None:
             raise RuntimeError("call reset() before step()")
         v, w, stopped = self.task.command(self._task_context, *self._command(action))
@@ -331,6 +343,7 @@ class HomingEnv(gym.Env):
                 self._info(collision, success, rewards))
 
     def render(self):
+        self._check_open()
         if self.render_mode == "rgb_array":
             return self.render_frame()
         if self.render_mode == "human" and self.episode is not None:
@@ -353,3 +366,8 @@ class HomingEnv(gym.Env):
     def close(self):
         if hasattr(self, "sim"):
             self.sim.close()
+
+    def _check_open(self) -> None:
+        if hasattr(self, "sim") and not self.sim.connected:
+            raise gym.error.ClosedEnvironmentError(
+                "this env was closed (its PyBullet world is gone); make a new one")

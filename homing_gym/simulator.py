@@ -16,6 +16,7 @@ import functools
 import math
 import os
 import pkgutil
+import sys
 import tempfile
 import warnings
 
@@ -226,6 +227,14 @@ class Simulator:
     @property
     def connected(self) -> bool:
         return self._connected
+
+
+def gui_unavailable() -> str | None:
+    """Why PyBullet's GUI cannot open here, or ``None``: on Linux it needs an X display,
+    and without one PyBullet ends the whole process from C instead of raising."""
+    if sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
+        return "no X display (DISPLAY is not set)"
+    return None
 
 
 SOFTWARE_GL = ("llvmpipe", "softpipe", "swrast")

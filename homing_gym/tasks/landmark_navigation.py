@@ -71,7 +71,7 @@ class LandmarkNavigationTask(Task):
         self.max_angle = math.radians(max_angle_deg)
         self.standoff = float(standoff)
         self.success_on = success_on
-        self.reward = reward
+        self.reward = RewardConfig.from_value(reward)
         self.clearance_margin = float(clearance_margin)
         self.view_size = (int(view_size[0]), int(view_size[1]))
         self.view_hfov_deg = float(view_hfov_deg)

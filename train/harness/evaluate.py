@@ -215,13 +215,21 @@ _WORKER: dict[str, Any] = {}
 
 
 def _init_worker(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any]) -> None:
-    env = gym.make(env_id, **env_kwargs)
-    policy = spec.build()
-    prepare_policy(policy, env)
-    _WORKER.update(env=env, policy=policy)
+    """Make the worker's env and policy. A failure is kept and raised by the first task:
+    a pool respawns workers whose initializer raises, forever."""
+    try:
+        env = gym.make(env_id, **env_kwargs)
+        _WORKER["env"] = env
+        policy = spec.build()
+        prepare_policy(policy, env)
+        _WORKER["policy"] = policy
+    except Exception as err:  # noqa: BLE001  (any failure: reported once, by the task)
+        _WORKER["error"] = err
 
 
 def _work(task: tuple) -> EpisodeRecord:
+    if "error" in _WORKER:
+        raise _WORKER["error"]
     return run_episode(_WORKER["env"], _WORKER["policy"], *task)
 
 
@@ -246,7 +254,9 @@ def run_episodes(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
                     records[i] = _work(task)
                     bar.update()
             finally:
-                _WORKER.pop("env").close()
+                env = _WORKER.pop("env", None)
+                if env is not None:
+                    env.close()
                 _WORKER.clear()
         else:
             ctx = mp.get_context("spawn")
@@ -315,10 +325,17 @@ def add_policy_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, default=0, help="seed of the first episode")
     parser.add_argument("--workers", type=int, default=1, help="parallel processes")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.add_argument("--trust-policy", action="store_true",
+                        help="load a model zip with pickle: RUNS CODE FROM THE FILE (only for "
+                        "files you trust; by default zips are read without unpickling)")
 
 
 def policy_from_args(args: argparse.Namespace) -> PolicySpec:
     params = parse_params(args.param, args.policy) if args.param else {}
+    if args.trust_policy:
+        if not args.policy.endswith(".zip"):
+            raise ValueError("--trust-policy applies to model .zip files only")
+        params["trust"] = True
     return policy_spec(args.policy, params)
 
 

@@ -1,0 +1,66 @@
+"""Bad input and misuse get one clear error, never a crash deep inside PyBullet or a hang."""
+
+import subprocess
+import sys
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+SMALL = {"panorama_shape": (16, 64)}
+
+
+def test_a_closed_env_says_so():
+    env = gym.make("homing_gym/LocalHoming-v0", render_mode="rgb_array", **SMALL)
+    env.reset(seed=0)
+    env.close()
+    for call in (lambda: env.reset(seed=0), lambda: env.step(env.action_space.sample()),
+                 env.render):
+        with pytest.raises(gym.error.ClosedEnvironmentError, match="closed"):
+            call()
+
+
+@pytest.mark.parametrize("action", [np.array([0.5 + 1j, 0.0]), ["0.5", "0"], [True, False],
+                                    [0.5, True], None, "forward"])
+def test_continuous_actions_must_be_real_numbers(action):
+    env = gym.make("homing_gym/LocalHoming-v0", **SMALL)
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="action"):
+        env.step(action)
+    env.close()
+
+
+@pytest.mark.parametrize("action", [np.nan, np.inf, None, True, 2.5, 4, -1, "1", 1 + 0j])
+def test_discrete_actions_must_be_one_of_the_four(action):
+    env = gym.make("homing_gym/LocalHoming-v0", action_type="discrete", **SMALL)
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match=r"discrete action .* is not one of 0 forward"):
+        env.step(action)
+    env.close()
+
+
+def test_human_render_without_a_display_is_refused_before_pybullet(monkeypatch):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.setattr(sys, "platform", "linux")
+    with pytest.raises(ValueError, match="render_mode='human'.*no X display"):
+        gym.make("homing_gym/LocalHoming-v0", render_mode="human")
+
+
+def test_landmark_navigation_takes_a_reward_mapping():
+    env = gym.make("homing_gym/LandmarkNavigation-v0", reward={"progress": 5.0},
+                   panorama_shape=(16, 64))
+    env.reset(seed=0)
+    _, _, _, _, info = env.step(env.action_space.sample())
+    assert set(info["rewards"]) >= {"progress", "time"}
+    env.close()
+
+
+@pytest.mark.slow
+def test_a_worker_that_cannot_start_ends_the_evaluation_once():
+    out = subprocess.run(
+        [sys.executable, "-m", "homing_train.harness.evaluate", "--policy", "random",
+         "--episodes", "4", "--workers", "2", "--quiet", "--env-kwargs",
+         '{"scene": "nowhere"}', "--out", "/tmp/never.json"],
+        capture_output=True, text=True, timeout=180)
+    assert out.returncode == 2
+    assert out.stderr.count("unknown scene") == 1, out.stderr[-2000:]
