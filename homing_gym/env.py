@@ -32,6 +32,11 @@ from homing_gym.topdown import compose_frame, draw_topdown
 from homing_gym.validation import require_positive
 
 ACTION_TYPES = ("continuous", "discrete")
+#: Bounds of the simulation settings: physics sub-steps per control period, the control
+#: period (seconds) and the physics step (seconds; longer steps let the robot pass
+#: through walls, shorter ones only cost time).
+MAX_SUBSTEPS, MAX_CONTROL_PERIOD = 1000, 2.0
+MIN_TIME_STEP, MAX_TIME_STEP = 1 / 2000, 1 / 60
 #: Observation keys the env core provides (tasks may add more): see
 #: :mod:`homing_gym.observations`.
 OBSERVATION_KEYS = (*CORE_KEYS, "goal_step")
@@ -66,9 +71,19 @@ class HomingEnv(gym.Env):
                              f"here: {why}; use render_mode='rgb_array' (frames as arrays)")
         if action_type not in ACTION_TYPES:
             raise ValueError(f"unknown action_type {action_type!r}; allowed: {ACTION_TYPES}")
-        if not (isinstance(physics_substeps, (int, np.integer)) and physics_substeps >= 1):
-            raise ValueError(f"physics_substeps must be an integer >= 1, got {physics_substeps!r}")
+        if not (isinstance(physics_substeps, (int, np.integer))
+                and 1 <= physics_substeps <= MAX_SUBSTEPS):
+            raise ValueError(f"physics_substeps must be an integer in [1, {MAX_SUBSTEPS}], "
+                             f"got {physics_substeps!r}")
         require_positive("control_period", control_period, "seconds")
+        time_step = control_period / physics_substeps
+        if not (control_period <= MAX_CONTROL_PERIOD
+                and MIN_TIME_STEP <= time_step <= MAX_TIME_STEP):
+            raise ValueError(
+                f"control_period {control_period!r} s in {physics_substeps} physics_substeps "
+                f"gives physics steps of {time_step:.3g} s; allowed: control_period <= "
+                f"{MAX_CONTROL_PERIOD} s and steps in [1/{round(1 / MIN_TIME_STEP)}, "
+                f"1/{round(1 / MAX_TIME_STEP)}] s (PyBullet's contacts fail beyond)")
         require_positive("max_speed", max_speed, "m/s")
         require_positive("max_yaw_rate", max_yaw_rate, "rad/s")
         if not (0 <= lighting_change <= 1):

@@ -6,6 +6,7 @@ import numpy as np
 
 from homing_gym.env import HomingEnv
 from homing_gym.geometry import FOOT
+from homing_gym.panorama import CameraConfig
 from homing_gym.scenes import SceneFactory, scene_factory
 from homing_gym.scenes.base import Scene
 from homing_gym.scenes.daily_changes import daily_changes as daily_changes_of
@@ -98,14 +99,17 @@ class LocalHomingEnv(HomingEnv):
     ``"random_arena"`` or a :class:`~homing_gym.scenes.Scene`), ``render_mode``
     (``None``, ``"rgb_array"``: top-down map beside current and goal panoramas;
     ``"human"``: PyBullet GUI), ``obs_keys``, ``panorama_shape`` = (48, 256),
-    ``vfov_deg`` = 60, ``n_views`` = 6, ``renderer`` (``"tiny"``, ``"egl"`` or ``"raycast"``: Embree ray casting, one ray
-    per pixel centre, see :mod:`homing_gym.raycast`), ``omni_size`` = 128,
-    ``action_type``, ``control_period``, ``physics_substeps``, ``max_speed``,
+    ``vfov_deg`` = 60, ``n_views`` = 6, ``renderer`` (``"tiny"``, ``"egl"`` or
+    ``"raycast"``: Embree ray casting, one ray per pixel centre, see
+    :mod:`homing_gym.raycast`), ``omni_size`` = 128,
+    ``action_type``, ``control_period`` (at most 2 s), ``physics_substeps`` (1-1000; each
+    physics step between 1/2000 and 1/60 s), ``max_speed``,
     ``max_yaw_rate``, ``stop_threshold``, ``odometry_noise`` = 0.02, ``goal_step_length`` = 0.15,
     ``lighting_change`` = 0
     (0-1: strength of an illumination change between the home snapshot and the run, drawn
     from the seed: light direction, brightness, contrast),
-    ``start_distance``, ``success_radius``, ``success_on``, ``reward`` (a
+    ``start_distance`` (its minimum at least ``success_radius``), ``success_radius``,
+    ``success_on``, ``reward`` (a
     ``RewardConfig``, or a dict of some of its fields, e.g. ``{"progress": 10.0}``),
     ``max_episode_steps``.
 
@@ -511,6 +515,7 @@ class WorkLocationsEnv(HomingEnv):
         if not (isinstance(daily_changes, (int, float)) and 0 <= daily_changes <= 1):
             raise ValueError(f"daily_changes must be in [0, 1] (0: the house as taught), "
                              f"got {daily_changes!r}")
+        CameraConfig(panorama_shape=tuple(panorama_shape))   # checks the shape first
         task = WorkLocationsTask(tuple(panorama_shape), start_location, goal_location,
                                  start_jitter=start_jitter, teach_levels=teach_levels,
                                  spacing=place_spacing, template_size=template_size,

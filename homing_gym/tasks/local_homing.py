@@ -25,6 +25,10 @@ class LocalHomingTask(GoalReachingTask):
             raise ValueError(f"start_distance must be (min, max) metres with 0 <= min <= max, "
                              f"got {start_distance!r}")
         super().__init__(success_radius, success_on, reward)
+        if lo < self.success_radius:
+            raise ValueError(f"start_distance {start_distance!r} m must start at or beyond "
+                             f"success_radius {self.success_radius!r} m: an episode must not "
+                             f"begin at home")
         self.start_distance = (float(lo), float(hi))
         self.clearance_margin = clearance_margin
 

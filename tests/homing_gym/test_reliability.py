@@ -64,3 +64,17 @@ def test_a_worker_that_cannot_start_ends_the_evaluation_once():
         capture_output=True, text=True, timeout=180)
     assert out.returncode == 2
     assert out.stderr.count("unknown scene") == 1, out.stderr[-2000:]
+
+
+@pytest.mark.parametrize("env_id, kwargs, words", [
+    ("homing_gym/LocalHoming-v0", {"physics_substeps": 10**8}, "physics_substeps"),
+    ("homing_gym/LocalHoming-v0", {"control_period": 1e5}, "control_period"),
+    ("homing_gym/LocalHoming-v0", {"control_period": 0.01, "physics_substeps": 100},
+     "physics steps"),
+    ("homing_gym/LocalHoming-v0", {"success_radius": 1e6}, "success_radius"),
+    ("homing_gym/LocalHoming-v0", {"start_distance": (0, 0)}, "start_distance"),
+    ("homing_gym/WorkLocations-v0", {"panorama_shape": (-48, 256)}, "panorama_shape"),
+])
+def test_settings_that_would_hang_fling_or_end_at_once_are_refused(env_id, kwargs, words):
+    with pytest.raises(ValueError, match=words):
+        gym.make(env_id, **kwargs)
