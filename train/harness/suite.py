@@ -25,6 +25,7 @@ import yaml
 import homing_baselines
 import homing_gym  # noqa: F401  (registers the env ids)
 from homing_gym.cli import command_parser
+from homing_train.extras import missing_extra
 from homing_train.harness.compare import compare
 from homing_train.harness.evaluate import DEFAULT_ENV, evaluate, format_summary
 
@@ -71,6 +72,9 @@ def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: in
     out.mkdir(parents=True, exist_ok=True)
     policies = {name: p for name, p in shipped_policies().items()
                 if p.env_id in (None, env_id)}
+    if policies and (hint := missing_extra("train")):
+        print(f"homing-suite: the learned rows {sorted(policies)} are left out ({hint})")
+        policies = {}
     made_for = suite_methods(env_id)
     candidates = homing_baselines.available() + sorted(policies)
     chosen = methods or made_for + sorted(policies)

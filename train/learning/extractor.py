@@ -19,7 +19,8 @@ from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from torch import nn
 from torch.nn import functional as F
 
-EXTRACTORS = ("panorama", "combined")
+from homing_train.learning import EXTRACTORS
+
 
 
 class CircularConv(nn.Module):

@@ -33,7 +33,8 @@ import yaml
 
 import homing_gym
 from homing_gym.cli import command_parser
-from homing_train.learning.extractor import EXTRACTORS, policy_kwargs_for
+from homing_train.extras import MissingExtraError, require_extra
+from homing_train.learning import EXTRACTORS
 from homing_train.learning.imitation import dagger
 from homing_train.learning.pretrain import pretrain
 
@@ -293,6 +294,8 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
     from stable_baselines3 import PPO
     from stable_baselines3.common.callbacks import CheckpointCallback, EvalCallback
 
+    from homing_train.learning.extractor import policy_kwargs_for
+
     import torch
 
     # One intra-op thread by default: with the env workers on the same cores, torch's
@@ -391,6 +394,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--extractor", choices=EXTRACTORS)
     parser.add_argument("--no-progress", action="store_true")
     args = parser.parse_args(argv)
+    try:
+        require_extra("train", "homing-train")
+    except MissingExtraError as err:
+        parser.exit(2, f"homing-train: error: {err}\n")
     try:
         if args.resume:
             run = Path(args.resume)

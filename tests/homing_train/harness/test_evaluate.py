@@ -181,3 +181,24 @@ def test_evaluate_gives_a_controller_the_observation_keys_it_reads():
                       env_kwargs={"max_episode_steps": 3, "obs_keys": ["panorama", "goal"]})
     assert chosen.env_kwargs["obs_keys"] == ["panorama", "goal"]
     assert chosen.episodes[0].start_pose == result.episodes[0].start_pose
+
+
+def test_missing_training_extra_is_one_line_and_the_suite_runs_without_it(monkeypatch, capsys,
+                                                                          tmp_path):
+    import importlib.util
+
+    from homing_train.harness import suite
+    from homing_train.learning import train as train_cli
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec",
+                        lambda name, *a: None if name == "stable_baselines3" else real(name, *a))
+    with pytest.raises(SystemExit) as exit_:
+        train_cli.main(["--timesteps", "8"])
+    assert exit_.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and 'pip install "homing-gym[train]"' in err
+    suite.run_suite(tmp_path, episodes=1, workers=1, methods=["random"])
+    out = capsys.readouterr().out
+    assert "learned rows ['ppo_localhoming'] are left out" in out
+    assert not (tmp_path / "ppo_localhoming.json").exists()
