@@ -19,10 +19,11 @@ import json
 import math
 import multiprocessing as mp
 import os
+import signal
 import sys
 import time
 from dataclasses import asdict, dataclass, field
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 import gymnasium as gym
 import numpy as np
@@ -227,6 +228,12 @@ def _init_worker(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any]) -> N
         _WORKER["error"] = err
 
 
+def _init_pool_worker(*args) -> None:
+    """A pool worker leaves Ctrl-C to the main process, which ends the pool."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _init_worker(*args)
+
+
 def _work(task: tuple) -> EpisodeRecord:
     if "error" in _WORKER:
         raise _WORKER["error"]
@@ -235,10 +242,12 @@ def _work(task: tuple) -> EpisodeRecord:
 
 def run_episodes(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
                  tasks: Sequence[tuple], workers: int = 1,
-                 progress: bool = True, desc: str = "episodes") -> list[EpisodeRecord]:
+                 progress: bool = True, desc: str = "episodes",
+                 on_record: Callable[[EpisodeRecord], None] | None = None
+                 ) -> list[EpisodeRecord]:
     """Run ``tasks`` = [(seed, start pose or None[, home pose or None]), ...] over
     ``workers`` processes (spawn context; 1 = in this process). Records come back in task
-    order."""
+    order; ``on_record`` sees each one as soon as it is finished (in finishing order)."""
     for task in tasks:
         if not 1 <= len(task) <= 3:
             raise ValueError(f"a task is (seed, start, home), got {task!r}")
@@ -252,6 +261,8 @@ def run_episodes(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
             try:
                 for i, task in enumerate(tasks):
                     records[i] = _work(task)
+                    if on_record is not None:
+                        on_record(records[i])
                     bar.update()
             finally:
                 env = _WORKER.pop("env", None)
@@ -260,11 +271,13 @@ def run_episodes(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
                 _WORKER.clear()
         else:
             ctx = mp.get_context("spawn")
-            with ctx.Pool(min(workers, len(tasks)), initializer=_init_worker,
+            with ctx.Pool(min(workers, len(tasks)), initializer=_init_pool_worker,
                           initargs=(spec, env_id, env_kwargs)) as pool:
                 indexed = pool.imap_unordered(_indexed_work, list(enumerate(tasks)))
                 for i, record in indexed:
                     records[i] = record
+                    if on_record is not None:
+                        on_record(record)
                     bar.update()
     finally:
         bar.close()
@@ -278,9 +291,15 @@ def _indexed_work(item: tuple[int, tuple]) -> tuple[int, EpisodeRecord]:
 def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int = 0,
              env_kwargs: dict[str, Any] | None = None, workers: int = 1,
              params: dict[str, Any] | None = None, bin_width: float = 0.3,
-             progress: bool = True) -> EvalResult:
+             progress: bool = True, stream: str | None = None,
+             resume: bool = False) -> EvalResult:
     """Evaluate ``policy`` (controller name, controller, :class:`PolicySpec` or SB3 zip
-    path) on episodes seeded ``seed .. seed + episodes - 1``."""
+    path) on episodes seeded ``seed .. seed + episodes - 1``.
+
+    ``stream``: a JSON-lines file that gets each finished episode at once (its first line
+    the settings), so an interrupted evaluation keeps what it finished; with ``resume``
+    the episodes already in it are kept and only the others are run (same settings
+    required), giving the records an uninterrupted run would give."""
     if episodes < 1:
         raise ValueError(f"episodes must be >= 1, got {episodes}")
     if env_id not in gym.registry:
@@ -290,11 +309,78 @@ def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int =
     if spec.kind == "controller" and "obs_keys" not in env_kwargs:
         # what the controller reads; observation keys never change the episodes
         env_kwargs["obs_keys"] = list(spec.build().observation_keys())
-    tasks = [(seed + i, None) for i in range(episodes)]
-    records = run_episodes(spec, env_id, env_kwargs, tasks, workers, progress,
-                           desc=f"{spec.label}")
+    settings = json.loads(json.dumps({"policy": spec.label, "params": spec.resolved_params(),
+                                      "env_id": env_id, "env_kwargs": env_kwargs},
+                                     default=_json_default))
+    done = read_stream(stream, settings) if stream and resume else {}
+    tasks = [(s, None) for s in range(seed, seed + episodes) if s not in done]
+    sink = open_stream(stream, settings, append=bool(done)) if stream else None
+    try:
+        fresh = run_episodes(spec, env_id, env_kwargs, tasks, workers, progress,
+                             desc=f"{spec.label}",
+                             on_record=None if sink is None else sink.write_record)
+    finally:
+        if sink is not None:
+            sink.close()
+    records = {r.seed: r for r in fresh} | done
     return EvalResult(policy=spec.label, params=spec.resolved_params(), env_id=env_id,
-                      env_kwargs=env_kwargs, seed=seed, episodes=records, bin_width=bin_width)
+                      env_kwargs=env_kwargs, seed=seed,
+                      episodes=[records[s] for s in range(seed, seed + episodes)],
+                      bin_width=bin_width)
+
+
+class _Stream:
+    """An open JSON-lines file of finished episodes, flushed line by line."""
+
+    def __init__(self, path: str, settings: dict, append: bool):
+        self.file = open(path, "a" if append else "w")
+        if not append:
+            self._line(settings)
+
+    def _line(self, doc: dict) -> None:
+        self.file.write(json.dumps(doc, default=_json_default) + "\n")
+        self.file.flush()
+
+    def write_record(self, record: EpisodeRecord) -> None:
+        self._line(asdict(record))
+
+    def close(self) -> None:
+        self.file.close()
+
+
+def open_stream(path: str, settings: dict, append: bool = False) -> _Stream:
+    """Open the episode stream (``ValueError`` naming the path if it cannot be written)."""
+    try:
+        os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+        return _Stream(path, settings, append)
+    except OSError as err:
+        raise ValueError(f"cannot write {path!r}: {err.strerror}") from None
+
+
+def read_stream(path: str, settings: dict) -> dict[int, EpisodeRecord]:
+    """The finished episodes of a stream written with the same ``settings``, by seed (none
+    if the file does not exist; a torn last line, from an interrupted write, is ignored)."""
+    if not os.path.exists(path):
+        return {}
+    with open(path) as f:
+        lines = f.read().splitlines()
+    docs = []
+    for line in lines:
+        try:
+            docs.append(json.loads(line))
+        except json.JSONDecodeError:
+            continue
+    if not docs or docs[0] != settings:
+        raise ValueError(f"{path} holds episodes of other settings ({docs[0] if docs else None});"
+                         f" cannot resume with {settings}")
+    names = {f.name for f in dataclasses.fields(EpisodeRecord)}
+    return {int(d["seed"]): EpisodeRecord(**{k: v for k, v in d.items() if k in names})
+            for d in docs[1:]}
+
+
+def stream_path(out: str) -> str:
+    """The episode stream beside a result JSON: ``NAME.episodes.jsonl``."""
+    return os.path.splitext(out)[0] + ".episodes.jsonl"
 
 
 # -- command line ---------------------------------------------------------------------------
@@ -357,15 +443,27 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--episodes", type=int, default=100)
     parser.add_argument("--bin-width", type=float, default=0.3,
                         help="start-distance bin width (m) for success by distance")
-    parser.add_argument("--out", required=True, help="result JSON path (a .csv goes beside)")
+    parser.add_argument("--out", required=True,
+                        help="result JSON path (a .csv goes beside; each finished episode is "
+                        "appended to NAME.episodes.jsonl as it ends)")
+    parser.add_argument("--resume", action="store_true",
+                        help="keep the episodes already in NAME.episodes.jsonl and run the rest")
     args = parser.parse_args(argv)
     try:
         spec = policy_from_args(args)
+        for path in (args.out, stream_path(args.out)):
+            if os.path.isdir(path):
+                raise ValueError(f"--out {path!r} is a directory")
         result = evaluate(spec, args.env, args.episodes, args.seed,
                           parse_json_kwargs(args.env_kwargs), args.workers,
-                          bin_width=args.bin_width, progress=not args.quiet)
+                          bin_width=args.bin_width, progress=not args.quiet,
+                          stream=stream_path(args.out), resume=args.resume)
     except ValueError as err:
         parser.exit(2, f"homing-eval: error: {err}\n")
+    except KeyboardInterrupt:
+        parser.exit(130, f"homing-eval: interrupted; the finished episodes are in "
+                         f"{stream_path(args.out)}: the same command with --resume runs "
+                         f"the rest\n")
     result.save(args.out)
     print(format_summary(result))
     print(f"wrote {args.out} and {os.path.splitext(args.out)[0]}.csv")

@@ -1,6 +1,7 @@
 """The harness: paired episodes, information isolation, JSON/CSV, CLIs, pictures."""
 
 import csv
+import dataclasses
 import json
 from dataclasses import dataclass
 from typing import ClassVar
@@ -202,3 +203,36 @@ def test_missing_training_extra_is_one_line_and_the_suite_runs_without_it(monkey
     out = capsys.readouterr().out
     assert "learned rows ['ppo_localhoming'] are left out" in out
     assert not (tmp_path / "ppo_localhoming.json").exists()
+
+
+def _without_wall_time(result):
+    return [{k: v for k, v in dataclasses.asdict(e).items() if k != "wall_time"}
+            for e in result.episodes]
+
+
+def test_an_interrupted_evaluation_resumes_to_the_uninterrupted_result(tmp_path):
+    from homing_train.harness.evaluate import evaluate
+
+    kwargs = {"max_episode_steps": 20, "panorama_shape": [16, 64]}
+    full = evaluate("random", episodes=4, seed=7, env_kwargs=kwargs, progress=False)
+    stream = tmp_path / "run.episodes.jsonl"
+    evaluate("random", episodes=2, seed=7, env_kwargs=kwargs, progress=False,
+             stream=str(stream))
+    with open(stream, "a") as f:
+        f.write('{"seed": 9, "start_po')          # a write torn by the interruption
+    resumed = evaluate("random", episodes=4, seed=7, env_kwargs=kwargs, progress=False,
+                       stream=str(stream), resume=True)
+    assert _without_wall_time(resumed) == _without_wall_time(full)
+    with pytest.raises(ValueError, match="other settings"):
+        evaluate("oracle", episodes=4, seed=7, env_kwargs=kwargs, progress=False,
+                 stream=str(stream), resume=True)
+
+
+def test_homing_eval_refuses_an_unwritable_out_before_running(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    with pytest.raises(SystemExit) as exit_:
+        eval_cli.main(["--policy", "random", "--episodes", "50", "--quiet",
+                       "--out", str(blocker / "sub" / "r.json")])
+    assert exit_.value.code == 2
+    assert "cannot write" in capsys.readouterr().err
