@@ -34,7 +34,8 @@ from homing_gym.cli import command_parser
 from homing_gym.paths import NoPathError, path_length, shortest_path
 from homing_gym.geometry import wrap_angle
 from homing_train.harness import metrics
-from homing_train.harness.policies import PolicySpec, parse_params, policy_spec
+from homing_train.harness.policies import (PolicySpec, parse_params, policy_spec,
+                                           recorded_settings)
 from homing_train.harness.rollout import prepare_policy, rollout
 
 SCHEMA = 1
@@ -306,6 +307,11 @@ def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int =
         raise ValueError(f"unknown env id {env_id!r}; homing-gym ids: {list(homing_gym.ENV_IDS)}")
     spec = policy_spec(policy, params)
     env_kwargs = dict(env_kwargs or {})
+    if spec.kind == "sb3":
+        # a zip is evaluated as it was shipped; explicit settings override the record
+        recorded = recorded_settings(spec.source)
+        env_kwargs = {**recorded.env_kwargs, **env_kwargs}
+        spec = dataclasses.replace(spec, params={**recorded.params, **spec.params})
     if spec.kind == "controller" and "obs_keys" not in env_kwargs:
         # what the controller reads; observation keys never change the episodes
         env_kwargs["obs_keys"] = list(spec.build().observation_keys())
@@ -465,6 +471,9 @@ def main(argv: list[str] | None = None) -> int:
                          f"{stream_path(args.out)}: the same command with --resume runs "
                          f"the rest\n")
     result.save(args.out)
+    if spec.kind == "sb3" and (recorded := recorded_settings(spec.source)).source:
+        print(f"settings recorded in {recorded.source} (explicit --env-kwargs/--param "
+              f"override them): env kwargs {result.env_kwargs}, params {result.params}")
     print(format_summary(result))
     print(f"wrote {args.out} and {os.path.splitext(args.out)[0]}.csv")
     return 0

@@ -56,6 +56,34 @@ class PolicySpec:
         return (self.instance if self.instance is not None else self.build()).params()
 
 
+@dataclass(frozen=True)
+class RecordedSettings:
+    """How a policy zip is evaluated, from the ``.yml`` beside it (written by
+    ``homing_train.learning.ship``): ``env_kwargs`` (``eval_env_kwargs``), ``params``
+    (``eval_params``, e.g. ``{"deterministic": False}``) and the ``env_id`` it was trained
+    on; ``source`` the ``.yml`` path, ``None`` when there is none."""
+
+    env_kwargs: dict[str, Any] = field(default_factory=dict)
+    params: dict[str, Any] = field(default_factory=dict)
+    env_id: str | None = None
+    source: str | None = None
+
+
+def recorded_settings(zip_path: str) -> RecordedSettings:
+    """The evaluation settings recorded beside the policy zip ``zip_path``."""
+    import yaml
+
+    meta_path = os.path.splitext(zip_path)[0] + ".yml"
+    if not os.path.isfile(meta_path):
+        return RecordedSettings()
+    try:
+        meta = yaml.safe_load(open(meta_path).read()) or {}
+    except yaml.YAMLError as err:
+        raise ValueError(f"{meta_path}: not readable YAML ({err})") from None
+    return RecordedSettings(dict(meta.get("eval_env_kwargs") or {}),
+                            dict(meta.get("eval_params") or {}), meta.get("env_id"), meta_path)
+
+
 def policy_spec(policy: str | Controller | PolicySpec,
                 params: dict[str, Any] | None = None) -> PolicySpec:
     """Interpret ``policy``: a :class:`PolicySpec`, a controller instance, a registered

@@ -20,14 +20,13 @@ from importlib import resources
 from pathlib import Path
 
 import gymnasium as gym
-import yaml
-
 import homing_baselines
 import homing_gym  # noqa: F401  (registers the env ids)
 from homing_gym.cli import command_parser
 from homing_train.extras import missing_extra
 from homing_train.harness.compare import compare
 from homing_train.harness.evaluate import DEFAULT_ENV, evaluate, format_summary
+from homing_train.harness.policies import recorded_settings
 
 POLICY_DIR = Path(str(resources.files("homing_train") / "shipped"))
 
@@ -43,15 +42,13 @@ class ShippedPolicy:
 
 
 def shipped_policies(folder: Path = POLICY_DIR) -> dict[str, ShippedPolicy]:
-    """Shipped PPO policies by name, with the ``eval_env_kwargs`` and ``eval_params`` of
-    the ``.yml`` beside each zip."""
+    """Shipped PPO policies by name, with their recorded evaluation settings
+    (:func:`homing_train.harness.policies.recorded_settings`)."""
     found = {}
     for model in sorted(folder.glob("*.zip")):
-        meta_path = model.with_suffix(".yml")
-        meta = yaml.safe_load(meta_path.read_text()) if meta_path.is_file() else {}
-        found[model.stem] = ShippedPolicy(model, dict(meta.get("eval_env_kwargs") or {}),
-                                          dict(meta.get("eval_params") or {}),
-                                          meta.get("env_id"))
+        settings = recorded_settings(str(model))
+        found[model.stem] = ShippedPolicy(model, settings.env_kwargs, settings.params,
+                                          settings.env_id)
     return found
 
 
