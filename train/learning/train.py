@@ -16,9 +16,11 @@ from __future__ import annotations
 
 import json
 import math
+import multiprocessing
 import platform
 import re
 import shlex
+import signal
 import sys
 import time
 from dataclasses import asdict, dataclass, field, fields
@@ -145,9 +147,13 @@ def make_config(env_id: str, settings: dict[str, Any], **flags: Any) -> TrainCon
 
 
 def make_env(env_id: str, env_kwargs: dict[str, Any]) -> gym.Env:
-    """A single env (top-level, so that subprocess workers can unpickle it)."""
+    """A single env (top-level, so that subprocess workers can unpickle it). In a worker
+    process Ctrl-C is left to the main process, which saves the run and closes the
+    workers."""
     import homing_gym  # noqa: F401  (registers the ids in a spawned worker)
 
+    if multiprocessing.current_process().name != "MainProcess":
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
     return gym.make(env_id, **env_kwargs)
 
 
@@ -179,10 +185,17 @@ def versions() -> dict[str, str]:
             "platform": platform.platform()}
 
 
+def checkpoint_steps(path: Path) -> int:
+    """Env steps of a checkpoint named ``ppo_<steps>_steps.zip``."""
+    match = re.search(r"ppo_(\d+)_steps", Path(path).name)
+    if match is None:
+        raise ValueError(f"{path}: not a checkpoint name ppo_<steps>_steps.zip")
+    return int(match.group(1))
+
+
 def latest_checkpoint(run: Path) -> Path | None:
     """The checkpoint with the most steps in ``run/checkpoints``, if any."""
-    found = [(int(m.group(1)), p) for p in (run / "checkpoints").glob("ppo_*_steps.zip")
-             if (m := re.search(r"ppo_(\d+)_steps", p.name))]
+    found = [(checkpoint_steps(p), p) for p in (run / "checkpoints").glob("ppo_*_steps.zip")]
     return max(found)[1] if found else None
 
 
@@ -301,19 +314,25 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
     # One intra-op thread by default: with the env workers on the same cores, torch's
     # thread pool spins against them and learn() ran 4x slower on 2 cores (docs/training.md).
     torch.set_num_threads(config.torch_threads)
+    # a bad env setting fails here, once, with its own message, before the run folder is
+    # written (in a subprocess worker it would surface as a broken pipe)
+    make_env(config.env_id, config.env_kwargs).close()
     out.mkdir(parents=True, exist_ok=True)
     (out / "config.yml").write_text(yaml.safe_dump(asdict(config), sort_keys=False))
     with open(out / "command.txt", "a") as f:
         f.write((command or shlex.join(sys.argv)) + "\n")
     (out / "versions.json").write_text(json.dumps(versions(), indent=2))
-    env = make_vec(config, config.n_envs, config.seed)
+    checkpoint = latest_checkpoint(out) if resume else None
+    # a resumed run draws new training episodes: its envs are seeded past the steps done
+    done_steps = checkpoint_steps(checkpoint) if checkpoint is not None else 0
+    env = make_vec(config, config.n_envs, config.seed + done_steps)
     eval_env = make_vec(TrainConfig(**{**asdict(config), "vec": "dummy"}), 1,
                         config.seed + EVAL_SEED_OFFSET)
-    checkpoint = latest_checkpoint(out) if resume else None
     try:
         if checkpoint is not None:
             model = PPO.load(checkpoint, env=env, device=config.device,
                              tensorboard_log=str(out / "tb"))
+            model._last_obs = None      # learn() resets the envs, with their new seeds
         else:
             model = PPO("MultiInputPolicy", env, seed=config.seed, device=config.device,
                         tensorboard_log=str(out / "tb"), verbose=0,
@@ -346,16 +365,22 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
         # a warm-started actor is not updated with a random critic's advantages
         warmup = min(max(config.critic_warmup_steps - start_steps, 0), max(remaining, 0))
         fresh = checkpoint is None
-        for steps, critic_only in ((warmup, True), (remaining - warmup, False)):
-            if steps <= 0:
-                continue
-            set_actor_trainable(model.policy, not critic_only)
-            model.learn(steps, callback=[eval_cb, ckpt_cb], progress_bar=progress,
-                        reset_num_timesteps=fresh, tb_log_name="ppo")
-            fresh = False
+        interrupted = False
+        try:
+            for steps, critic_only in ((warmup, True), (remaining - warmup, False)):
+                if steps <= 0:
+                    continue
+                set_actor_trainable(model.policy, not critic_only)
+                model.learn(steps, callback=[eval_cb, ckpt_cb], progress_bar=progress,
+                            reset_num_timesteps=fresh, tb_log_name="ppo")
+                fresh = False
+        except KeyboardInterrupt:           # Ctrl-C: keep what was learned, say so
+            interrupted = True
         set_actor_trainable(model.policy, True)
         wall = time.perf_counter() - t0
         model.save(out / "model.zip")
+        if interrupted:                     # --resume continues from here
+            model.save(out / "checkpoints" / f"ppo_{model.num_timesteps}_steps.zip")
         summary_path = out / "summary.json"
         previous = json.loads(summary_path.read_text()) if summary_path.is_file() else {}
         sessions = previous.get("sessions", []) + [{
@@ -367,11 +392,14 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
             "timesteps": int(model.num_timesteps), "wall_time_s": round(total_wall, 1),
             "env_steps_per_s": round(sum(s["to_step"] - s["from_step"] for s in sessions)
                                      / max(total_wall, 1e-9), 1),
-            "sessions": sessions}, indent=2))
+            "sessions": sessions, "interrupted": interrupted}, indent=2))
         plot_learning_curve(out)
     finally:
-        env.close()
-        eval_env.close()
+        for vec in (env, eval_env):
+            try:
+                vec.close()
+            except (EOFError, BrokenPipeError, ConnectionResetError):
+                pass                        # workers already gone after Ctrl-C
     return model
 
 
@@ -417,8 +445,16 @@ def main(argv: list[str] | None = None) -> int:
                                    f"_s{config.seed}")
     except ValueError as err:
         parser.error(str(err))
-    train(config, run, resume=bool(args.resume), progress=not args.no_progress)
-    print(f"run folder: {run} ({json.loads((run / 'summary.json').read_text())})")
+    try:
+        train(config, run, resume=bool(args.resume), progress=not args.no_progress)
+    except ValueError as err:
+        parser.exit(2, f"homing-train: error: {err}\n")
+    summary = json.loads((run / "summary.json").read_text())
+    if summary.get("interrupted"):
+        print(f"interrupted at step {summary['timesteps']}: model.zip, a checkpoint and "
+              f"summary.json are saved; homing-train --resume {run} continues")
+        return 130
+    print(f"run folder: {run} ({summary})")
     return 0
 
 

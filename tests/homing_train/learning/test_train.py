@@ -235,3 +235,46 @@ def test_suite_runs_the_controllers_made_for_the_env():
     assert not {"multires", "selfsimilar", "bearing", "bearing-longrange"} & set(local)
     assert "multires" in suite_methods("homing_gym/WorkLocations-v0")
     assert "bearing-longrange" in suite_methods("homing_gym/LongRangeHoming-v0")
+
+
+def test_ctrl_c_saves_the_run_and_resume_continues_with_new_episode_seeds(tmp_path,
+                                                                          monkeypatch):
+    from stable_baselines3 import PPO
+
+    from homing_train.learning import train as train_module
+
+    real_learn = PPO.learn
+
+    def learn_then_interrupt(self, *args, **kwargs):
+        real_learn(self, *args, **kwargs)
+        raise KeyboardInterrupt
+
+    run = tmp_path / "run"
+    monkeypatch.setattr(PPO, "learn", learn_then_interrupt)
+    assert main(["--timesteps", "128", "--out", str(run), *TINY]) == 130
+    summary = json.loads((run / "summary.json").read_text())
+    assert summary["interrupted"] and (run / "model.zip").is_file()
+    assert latest_checkpoint(run).name == "ppo_128_steps.zip"
+    monkeypatch.setattr(PPO, "learn", real_learn)
+    seeds = []
+    real_make_vec = train_module.make_vec
+    monkeypatch.setattr(train_module, "make_vec",
+                        lambda config, n, seed: seeds.append(seed) or real_make_vec(config, n,
+                                                                                     seed))
+    assert main(["--resume", str(run), "--timesteps", "256", "--no-progress"]) == 0
+    config_seed = yaml.safe_load((run / "config.yml").read_text())["seed"]
+    assert seeds[0] == config_seed + 128          # training envs: not the first run's seeds
+    summary = json.loads((run / "summary.json").read_text())
+    assert not summary["interrupted"] and summary["timesteps"] == 256
+    assert summary["wall_time_s"] == pytest.approx(
+        sum(s["wall_time_s"] for s in summary["sessions"]))
+
+
+def test_a_bad_env_setting_is_one_error_and_leaves_no_run_folder(tmp_path, capsys):
+    run = tmp_path / "bad"
+    with pytest.raises(SystemExit) as exit_:
+        main(["--timesteps", "64", "--out", str(run), "--n-envs", "2", "--vec", "subproc",
+              "--env-kwargs", '{"scene": "nowhere"}', "--no-progress"])
+    assert exit_.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("unknown scene 'nowhere'") == 1 and not run.exists()
