@@ -1,0 +1,118 @@
+"""Fuzz: a seeded sample of bad constructor arguments and actions for every env id, each
+case in its own subprocess with a timeout, must end in a clear error.
+
+Each case makes the env, resets it and steps it; the outcome is one of ``clear`` (a
+``ValueError``/``TypeError`` or Gymnasium error naming the problem), ``accepted`` (no error:
+for a bad input, silently accepted), ``deep`` (any other exception, from deep inside
+PyBullet or numpy), ``crash`` (the process died) or ``hang`` (past the timeout).
+``python tests/homing_gym/test_fuzz.py`` prints the counts.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from collections import Counter
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+import pytest
+
+ENV_IDS = ("homing_gym/LocalHoming-v0", "homing_gym/RouteFollowing-v0",
+           "homing_gym/LongRangeHoming-v0", "homing_gym/LandmarkNavigation-v0",
+           "homing_gym/WorkLocations-v0")
+NAN, INF = "nan", "inf"   # JSON-safe stand-ins, turned into floats in the case script
+BAD_KWARGS = [
+    {"physics_substeps": 0}, {"physics_substeps": 10**8}, {"physics_substeps": 2.5},
+    {"physics_substeps": "24"}, {"control_period": 0}, {"control_period": 1e5},
+    {"control_period": NAN}, {"control_period": "0.1"}, {"max_speed": -1},
+    {"max_speed": NAN}, {"max_yaw_rate": INF}, {"panorama_shape": [-48, 256]},
+    {"panorama_shape": [48]}, {"panorama_shape": "48x256"}, {"panorama_shape": [100000, 64]},
+    {"success_radius": 0}, {"success_radius": -1}, {"success_radius": NAN},
+    {"lighting_change": -1}, {"lighting_change": 2}, {"lighting_change": NAN},
+    {"obs_keys": []}, {"obs_keys": ["nope"]}, {"obs_keys": ["panorama", "panorama"]},
+    {"action_type": "nope"}, {"render_mode": "ascii"}, {"odometry_noise": -1},
+    {"scene": "nowhere"}, {"scene": 5}, {"reward": {"nope": 1}},
+    {"reward": {"progress": "x"}}, {"reward": {"progress": NAN}}, {"stop_threshold": 2},
+    {"vfov_deg": 500}, {"renderer": "nope"}, {"omni_size": 3},
+]
+BAD_ACTIONS = {"continuous": [[NAN, 0], [INF, 0], None, "forward", [1, 2, 3], [True, False],
+                              {"complex": [0.5, 1]}],
+               "discrete": [NAN, INF, None, "1", 7, -1, 2.5, True]}
+
+CASE_SCRIPT = """
+import json, math, sys
+import gymnasium as gym, numpy as np, homing_gym
+case = json.loads(sys.argv[1])
+def real(v):
+    if v in ("nan", "inf"): return float(v)
+    if isinstance(v, list): return [real(x) for x in v]
+    if isinstance(v, dict) and set(v) == {"complex"}: return np.array(v["complex"]) + 1j
+    if isinstance(v, dict): return {k: real(x) for k, x in v.items()}
+    return v
+try:
+    env = gym.make(case["env_id"], **real(case["kwargs"]))
+    env.reset(seed=0)
+    for _ in range(2):
+        env.step(real(case["action"]) if "action" in case else env.action_space.sample())
+    env.close()
+    print(json.dumps(["accepted", ""]))
+except (ValueError, TypeError, gym.error.Error) as err:
+    print(json.dumps(["clear", f"{type(err).__name__}: {err}"]))
+except Exception as err:
+    print(json.dumps(["deep", f"{type(err).__name__}: {err}"]))
+"""
+
+
+def cases(n_kwargs: int = 40, seed: int = 0) -> list[dict]:
+    """A seeded sample of constructor cases over the env ids, and every bad action."""
+    rng = np.random.default_rng(seed)
+    out = [{"env_id": ENV_IDS[int(rng.integers(len(ENV_IDS)))],
+            "kwargs": BAD_KWARGS[int(i)]}
+           for i in rng.permutation(len(BAD_KWARGS))[:n_kwargs]]
+    for action_type, actions in BAD_ACTIONS.items():
+        for action in actions:
+            out.append({"env_id": "homing_gym/LocalHoming-v0",
+                        "kwargs": {"action_type": action_type, "panorama_shape": [16, 64]},
+                        "action": action})
+    return out
+
+
+def run_case(case: dict, timeout: float = 60.0) -> tuple[str, str]:
+    """``(outcome, message)`` of one case in a fresh interpreter."""
+    try:
+        out = subprocess.run([sys.executable, "-c", CASE_SCRIPT, json.dumps(case)],
+                             capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return "hang", f"no answer in {timeout} s"
+    lines = out.stdout.strip().splitlines()
+    if out.returncode != 0 or not lines:
+        return "crash", (out.stderr.strip().splitlines() or ["exit %d" % out.returncode])[-1]
+    outcome, message = json.loads(lines[-1])
+    return outcome, message
+
+
+def run_all(workers: int = 2) -> list[tuple[dict, str, str]]:
+    sample = cases()
+    with ThreadPoolExecutor(workers) as pool:
+        results = list(pool.map(run_case, sample))
+    return [(case, *result) for case, result in zip(sample, results)]
+
+
+@pytest.mark.slow
+def test_every_bad_input_gets_a_clear_error():
+    results = run_all()
+    bad = [(case, outcome, message) for case, outcome, message in results
+           if outcome != "clear"]
+    assert bad == [], "\n".join(f"{o}: {c} -> {m}" for c, o, m in bad)
+
+
+if __name__ == "__main__":
+    results = run_all()
+    counts = Counter(outcome for _, outcome, _ in results)
+    print(f"tried {len(results)}: " + ", ".join(f"{k} {counts.get(k, 0)}" for k in
+                                                ("clear", "accepted", "deep", "crash", "hang")))
+    for case, outcome, message in results:
+        if outcome != "clear":
+            print(f"  {outcome}: {case} -> {message[:160]}")
