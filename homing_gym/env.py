@@ -62,7 +62,9 @@ class HomingEnv(gym.Env):
                  physics_substeps: int = 24, max_speed: float = RobotConfig.max_speed,
                  max_yaw_rate: float = RobotConfig.max_yaw_rate, stop_threshold: float = 0.05,
                  odometry_noise: float = 0.02, lighting_change: float = 0.0,
-                 goal_step_length: float = 0.15):
+                 goal_step_length: float = 0.15,
+                 camera_height: float = RobotConfig.camera_height,
+                 sky_color: tuple[float, float, float] | None = None):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"unknown render_mode {render_mode!r}; allowed: "
                              f"{self.metadata['render_modes']} or None")
@@ -108,8 +110,20 @@ class HomingEnv(gym.Env):
         self.lighting_change = float(lighting_change)
         self.goal_step_length = float(goal_step_length)
         self._lighting: Lighting | None = None
+        if not (isinstance(camera_height, (int, float)) and 0.005 <= camera_height <= 5.0):
+            raise ValueError(f"camera_height must be in [0.005, 5] metres above the floor, "
+                             f"got {camera_height!r}")
+        if sky_color is not None:
+            if renderer != "raycast":
+                raise ValueError(f"sky_color needs renderer='raycast' (the {renderer!r} "
+                                 f"renderer's background is fixed), got renderer={renderer!r}")
+            if len(sky_color) != 3 or not all(
+                    isinstance(c, (int, float)) and 0 <= c <= 1 for c in sky_color):
+                raise ValueError(f"sky_color must be three RGB values in [0, 1], "
+                                 f"got {sky_color!r}")
         self.robot_config = RobotConfig(max_speed=float(max_speed),
-                                        max_yaw_rate=float(max_yaw_rate))
+                                        max_yaw_rate=float(max_yaw_rate),
+                                        camera_height=float(camera_height))
         camera_config = CameraConfig(
             panorama_shape=tuple(panorama_shape), vfov=math.radians(vfov_deg),
             n_views=n_views, omni_size=omni_size, renderer=renderer)
@@ -119,7 +133,8 @@ class HomingEnv(gym.Env):
         task.check_scene(self.scene)
         self.sim = Simulator(self.scene, gui=render_mode == "human",
                              time_step=self.control_period / self.physics_substeps,
-                             robot_config=self.robot_config, renderer=renderer)
+                             robot_config=self.robot_config, renderer=renderer,
+                             sky_color=sky_color)
         self.camera = PanoramaCamera(
             camera_config, self.robot_config.camera_height, renderer=self.sim.renderer,
             caster=(lambda: self.sim.caster) if self.sim.caster is not None else None)

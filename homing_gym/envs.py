@@ -108,6 +108,9 @@ class LocalHomingEnv(HomingEnv):
     ``lighting_change`` = 0
     (0-1: strength of an illumination change between the home snapshot and the run, drawn
     from the seed: light direction, brightness, contrast),
+    ``camera_height`` = 0.30 (metres above the floor, 0.005-5; below the robot's top,
+    about 0.1 m, use ``renderer="raycast"``, which never sees the robot's own body),
+    ``sky_color`` (RGB in [0, 1] of rays that hit nothing; ``renderer="raycast"`` only),
     ``start_distance`` (its minimum at least ``success_radius``), ``success_radius``,
     ``success_on``, ``reward`` (a
     ``RewardConfig``, or a dict of some of its fields, e.g. ``{"progress": 10.0}``),

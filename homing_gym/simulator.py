@@ -25,7 +25,7 @@ import pybullet as p
 from pybullet_utils.bullet_client import BulletClient
 
 from homing_gym.native_output import native_output_captured
-from homing_gym.raycast import RayCaster
+from homing_gym.raycast import SKY_COLOR, RayCaster
 from homing_gym.robot import Robot, RobotConfig
 from homing_gym.scenes.base import Landmark, Scene, Wall
 from homing_gym.textures import texture_path
@@ -38,7 +38,8 @@ class Simulator:
     """One PyBullet client holding a scene and the robot."""
 
     def __init__(self, scene: Scene, *, gui: bool = False, time_step: float = 1 / 240,
-                 robot_config: RobotConfig = RobotConfig(), renderer: str = "tiny"):
+                 robot_config: RobotConfig = RobotConfig(), renderer: str = "tiny",
+                 sky_color: tuple[float, float, float] | None = None):
         with native_output_captured():    # the C++ core prints "argv[0]=" on connecting
             self.client = BulletClient(connection_mode=p.GUI if gui else p.DIRECT)
         self._connected = True
@@ -46,7 +47,9 @@ class Simulator:
         # the EGL plugin only sees bodies created after it is loaded: load it first
         self.renderer = load_egl(c) if renderer == "egl" else p.ER_TINY_RENDERER
         #: The ray caster of the current world (``renderer="raycast"``), else None.
-        self.caster = RayCaster(world_mesh(scene)) if renderer == "raycast" else None
+        self.sky_color = SKY_COLOR if sky_color is None else tuple(sky_color)
+        self.caster = (RayCaster(world_mesh(scene), self.sky_color) if renderer == "raycast"
+                       else None)
         c.setGravity(0, 0, -9.81)
         c.setTimeStep(time_step)
         c.setPhysicsEngineParameter(deterministicOverlappingPairs=1, numSolverIterations=10)
@@ -184,7 +187,7 @@ class Simulator:
         self.obstacle_ids = frozenset(self.wall_ids + self.landmark_ids)
         self.scene = scene
         if self.caster is not None:
-            self.caster = RayCaster(world_mesh(scene))
+            self.caster = RayCaster(world_mesh(scene), self.sky_color)
 
     def place_robot(self, pose, clear_contacts: bool = False) -> None:
         """Teleport the robot to ``pose`` (x, y, yaw; metres, radians). With

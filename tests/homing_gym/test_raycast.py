@@ -129,3 +129,20 @@ def test_without_embreex_raycast_is_a_clear_error(monkeypatch):
     env = gym.make("homing_gym/LocalHoming-v0", renderer="tiny", panorama_shape=(16, 64))
     env.reset(seed=0)
     env.close()
+
+
+def test_camera_height_and_sky_color():
+    """An ant's eye 1 cm above the floor sees the horizon line of a flat floor at the
+    panorama's middle row; the sky takes the given colour."""
+    env = gym.make("homing_gym/LocalHoming-v0", scene=_pole_scene(2.0, 0.0),
+                   renderer="raycast", camera_height=0.01, sky_color=(0.0, 0.0, 1.0),
+                   panorama_shape=(48, 64), start_distance=(0.3, 0.5))
+    env.reset(seed=0)
+    pano = env.unwrapped.render_panorama(np.array([0.0, 0.0, 0.0]))
+    env.close()
+    far = pano[:, 0]                                  # looking backwards: floor and sky only
+    assert np.all(far[:24] == [0, 0, 255]) and np.all(far[24:, 2] < 200)
+    with pytest.raises(ValueError, match="sky_color needs renderer='raycast'"):
+        gym.make("homing_gym/LocalHoming-v0", sky_color=(0, 0, 1))
+    with pytest.raises(ValueError, match="camera_height"):
+        gym.make("homing_gym/LocalHoming-v0", camera_height=-1)
