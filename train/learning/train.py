@@ -320,7 +320,8 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
     out.mkdir(parents=True, exist_ok=True)
     (out / "config.yml").write_text(yaml.safe_dump(asdict(config), sort_keys=False))
     with open(out / "command.txt", "a") as f:
-        f.write((command or shlex.join(sys.argv)) + "\n")
+        # the installed command's name, not this machine's path to it
+        f.write((command or shlex.join(["homing-train", *sys.argv[1:]])) + "\n")
     (out / "versions.json").write_text(json.dumps(versions(), indent=2))
     checkpoint = latest_checkpoint(out) if resume else None
     # a resumed run draws new training episodes: its envs are seeded past the steps done
