@@ -46,3 +46,7 @@ from homing_gym.envs import (LandmarkNavigationEnv, LocalHomingEnv,  # noqa: E40
 __all__ = ["ENV_IDS", "FOOT", "TAUGHT_KEYS", "DiscreteAction", "HomingEnv", "LandmarkNavigationEnv", "LocalHomingEnv",
            "LongRangeHomingEnv", "RouteFollowingEnv", "WorkLocationsEnv",
            "register_envs", "__version__"]
+
+from homing_gym.cli import import_listed_modules  # noqa: E402
+
+import_listed_modules()     # a user's scenes and env ids in worker processes (--import)

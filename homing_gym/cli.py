@@ -1,10 +1,22 @@
 """One shape for every command of the package: ``prog`` named, defaults shown in ``--help``,
-plain-text descriptions taken from the module docstring."""
+plain-text descriptions taken from the module docstring, and ``--import MODULE``.
+
+``--import MODULE`` (repeatable) imports a user's module before any env is made, so that
+its ``register_scene(...)`` or ``gym.register(...)`` is visible to the command. The names
+are also put in the environment variable :data:`IMPORT_VARIABLE`, which
+``homing_gym/__init__`` reads, so that worker processes (spawned evaluation workers,
+``SubprocVecEnv``) import them too.
+"""
 
 from __future__ import annotations
 
 import argparse
+import importlib
+import os
 import re
+
+#: Comma-separated modules that ``import homing_gym`` imports (set by ``--import``).
+IMPORT_VARIABLE = "HOMING_GYM_IMPORT"
 
 
 class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter,
@@ -32,9 +44,39 @@ def plain(text: str) -> str:
     return text.replace("``", "")
 
 
+def import_user_module(name: str) -> None:
+    """Import ``name`` here and, through :data:`IMPORT_VARIABLE`, in worker processes."""
+    try:
+        importlib.import_module(name)
+    except ImportError as err:
+        raise ValueError(f"--import {name!r}: cannot import it ({err})") from None
+    listed = [m for m in os.environ.get(IMPORT_VARIABLE, "").split(",") if m]
+    if name not in listed:
+        os.environ[IMPORT_VARIABLE] = ",".join([*listed, name])
+
+
+def import_listed_modules() -> None:
+    """Import the modules listed in :data:`IMPORT_VARIABLE` (in a worker process)."""
+    for name in filter(None, os.environ.get(IMPORT_VARIABLE, "").split(",")):
+        importlib.import_module(name)
+
+
+class _ImportAction(argparse.Action):
+    def __call__(self, parser, namespace, value, option_string=None):
+        try:
+            import_user_module(value)
+        except ValueError as err:
+            parser.error(str(err))
+        getattr(namespace, self.dest).append(value)
+
+
 def command_parser(prog: str, doc: str | None) -> argparse.ArgumentParser:
     """An argument parser for command ``prog`` whose description is the first paragraph
-    of ``doc`` (a module docstring) in plain text."""
+    of ``doc`` (a module docstring) in plain text, with ``--import MODULE``."""
     first = (doc or "").strip().split("\n\n")[0]
-    return argparse.ArgumentParser(prog=prog, description=plain(first),
-                                   formatter_class=HelpFormatter)
+    parser = argparse.ArgumentParser(prog=prog, description=plain(first),
+                                     formatter_class=HelpFormatter)
+    parser.add_argument("--import", dest="imports", action=_ImportAction, default=[],
+                        metavar="MODULE", help="import this module first, e.g. one that "
+                        "registers your scene or env id (repeatable; workers import it too)")
+    return parser

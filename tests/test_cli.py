@@ -41,3 +41,28 @@ def test_help_names_the_command_and_shows_defaults(prog, capsys):
 def test_plain_drops_rest_markup():
     assert plain("see :mod:`homing_gym.env` and ``x = 1``, :func:`~a.b.c`") == \
         "see homing_gym.env and x = 1, c"
+
+
+@pytest.mark.slow
+def test_import_makes_a_user_scene_visible_to_the_command_and_its_workers(tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    (tmp_path / "my_world.py").write_text(
+        "from homing_gym.scenes import Landmark, Scene, SceneFactory, register_scene, "
+        "square_walls\n"
+        "register_scene('two_poles', SceneFactory(lambda rng: Scene('two_poles', "
+        "bounds=((-1.5, -1.5), (1.5, 1.5)), walls=square_walls(3.0), "
+        "landmarks=(Landmark((0.5, 0.5), radius=0.05, height=1.0),))))\n")
+    env = {**os.environ, "PYTHONPATH": str(tmp_path)}
+    command = [sys.executable, "-m", "homing_train.harness.evaluate", "--policy", "oracle",
+               "--episodes", "2", "--workers", "2", "--quiet", "--env-kwargs",
+               '{"scene": "two_poles", "max_episode_steps": 5}', "--out",
+               str(tmp_path / "r.json")]
+    without = subprocess.run(command, capture_output=True, text=True, env=env, timeout=300)
+    assert without.returncode == 2 and "unknown scene 'two_poles'" in without.stderr
+    with_import = subprocess.run([*command, "--import", "my_world"], capture_output=True,
+                                 text=True, env=env, timeout=300)
+    assert with_import.returncode == 0, with_import.stderr[-2000:]
+    assert "oracle on homing_gym/LocalHoming-v0: 2 episodes" in with_import.stdout
