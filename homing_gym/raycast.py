@@ -102,7 +102,7 @@ class RayCaster:
         out = np.empty((n, 3), np.float32)
         out[~ok] = self.sky
         p = prim[ok]
-        color = self.mesh.colors[p].copy()
+        color = self.mesh.colors[p]                # fancy indexing: a copy
         tex = self.mesh.texture[p]
         if np.any(tex >= 0):
             u, v = hit["u"][ok], hit["v"][ok]
