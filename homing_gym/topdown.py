@@ -56,6 +56,18 @@ def draw_scene(scene: Scene, canvas: MapCanvas) -> np.ndarray:
     return img
 
 
+def draw_scale_bar(img: np.ndarray, canvas: MapCanvas, metres: float = 0.5) -> None:
+    """A ``metres`` scale bar in the map's lower left corner."""
+    h = img.shape[0]
+    x0, y = 10, h - 12
+    x1 = x0 + canvas.length(metres)
+    cv2.line(img, (x0, y), (x1, y), (0, 0, 0), 2)
+    for x in (x0, x1):
+        cv2.line(img, (x, y - 4), (x, y + 4), (0, 0, 0), 1)
+    cv2.putText(img, f"{metres:g} m", (x0, y - 7), cv2.FONT_HERSHEY_SIMPLEX, 0.4, (0, 0, 0), 1,
+                cv2.LINE_AA)
+
+
 def draw_pose(img: np.ndarray, canvas: MapCanvas, pose, radius: float, color,
               filled: bool = True) -> None:
     """A robot-sized disc with a heading tick."""

@@ -25,10 +25,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from homing_gym.cli import command_parser  # noqa: E402
-from homing_gym.topdown import HOME, MapCanvas, draw_pose, draw_scene  # noqa: E402
+from homing_gym.topdown import MapCanvas, draw_pose, draw_scale_bar, draw_scene  # noqa: E402
 from homing_train.harness.evaluate import EvalResult  # noqa: E402
+from homing_train.harness.palette import (HOME_MARK, START_MARK, method_color,  # noqa: E402
+                                          method_color_255)
 
-COLORS = plt.get_cmap("tab10").colors
 
 
 def _ci(summary: dict, key: str, ci_key: str, scale: float = 1.0, fmt: str = ".2f") -> str:
@@ -68,21 +69,41 @@ def check_paired(results: Sequence[EvalResult]) -> list[int]:
     return shared
 
 
+def wilson_interval(successes: int, n: int, confidence: float = 0.95) -> tuple[float, float]:
+    """Wilson score interval of a success rate (``scipy.stats.binomtest``)."""
+    from scipy.stats import binomtest
+
+    ci = binomtest(successes, n).proportion_ci(confidence_level=confidence, method="wilson")
+    return float(ci.low), float(ci.high)
+
+
+def _legend_outside(ax) -> None:
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False)
+
+
 def plot_success_vs_distance(results: Sequence[EvalResult], path: str) -> None:
-    """Success rate (with 95% CI) against start distance, one line per method."""
-    fig, ax = plt.subplots(figsize=(5.5, 3.6), dpi=100)
-    for i, r in enumerate(results):
+    """Success rate against start distance, one line per method in its fixed colour,
+    95% Wilson intervals as bands, the number of episodes per bin written under it."""
+    fig, ax = plt.subplots(figsize=(7.0, 3.8), dpi=110)
+    for r in results:
         bins = r.summary["success_by_distance"]
-        x = [100 * (b["lo"] + b["hi"]) / 2 for b in bins]
-        y = [100 * b["success_rate"] for b in bins]
-        err = [[100 * (b["success_rate"] - b["success_ci"][0]) for b in bins],
-               [100 * (b["success_ci"][1] - b["success_rate"]) for b in bins]]
-        ax.errorbar(x, y, yerr=err, marker="o", capsize=3, color=COLORS[i % 10], label=r.policy)
-    ax.set_xlabel("start distance from home (cm)")
+        x = np.array([100 * (b["lo"] + b["hi"]) / 2 for b in bins])
+        k = [round(b["success_rate"] * b["n"]) for b in bins]
+        y = np.array([100 * b["success_rate"] for b in bins])
+        lo, hi = np.array([wilson_interval(ki, b["n"]) for ki, b in zip(k, bins)]).T * 100
+        color = method_color(r.policy)
+        ax.plot(x, y, marker="o", color=color, label=r.policy)
+        ax.fill_between(x, lo, hi, color=color, alpha=0.12, lw=0)
+    first = results[0].summary["success_by_distance"]
+    for b in first:
+        ax.annotate(f"n={b['n']}", (100 * (b["lo"] + b["hi"]) / 2, -9), ha="center",
+                    fontsize=7, color="0.35", annotation_clip=False)
+    ax.set_xlabel("start distance from home (cm); n = episodes per bin")
     ax.set_ylabel("success rate (%)")
     ax.set_ylim(-3, 103)
+    ax.set_title("Success by start distance (bands: 95% Wilson intervals)", fontsize=9)
     ax.grid(alpha=0.3)
-    ax.legend()
+    _legend_outside(ax)
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
@@ -90,17 +111,18 @@ def plot_success_vs_distance(results: Sequence[EvalResult], path: str) -> None:
 
 def plot_final_distance(results: Sequence[EvalResult], path: str) -> None:
     """Empirical CDF of the final distance to home, one line per method."""
-    fig, ax = plt.subplots(figsize=(5.5, 3.6), dpi=100)
-    for i, r in enumerate(results):
+    fig, ax = plt.subplots(figsize=(7.0, 3.8), dpi=110)
+    for r in results:
         d = np.sort([100 * e.final_distance for e in r.episodes])
-        ax.step(d, np.arange(1, d.size + 1) / d.size, where="post", color=COLORS[i % 10],
-                label=r.policy)
+        ax.step(d, np.arange(1, d.size + 1) / d.size, where="post",
+                color=method_color(r.policy), label=f"{r.policy} (n={d.size})")
     radius = results[0].env_kwargs.get("success_radius", 0.15)
     ax.axvline(100 * radius, color="grey", ls="--", lw=1, label="success radius")
     ax.set_xlabel("final distance to home (cm)")
     ax.set_ylabel("fraction of episodes")
+    ax.set_title("Final distance to home (empirical CDF)", fontsize=9)
     ax.grid(alpha=0.3)
-    ax.legend()
+    _legend_outside(ax)
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
@@ -108,7 +130,8 @@ def plot_final_distance(results: Sequence[EvalResult], path: str) -> None:
 
 def plot_trajectories(results: Sequence[EvalResult], seeds: Sequence[int], path: str,
                       size: int = 300) -> None:
-    """Top-down maps of the episodes ``seeds``: every method's path in its colour."""
+    """Top-down maps of the episodes ``seeds``: every method's path in its colour, home
+    and start as rings, a scale bar."""
     first = results[0]
     env = gym.make(first.env_id, **first.env_kwargs)
     panels = []
@@ -118,35 +141,36 @@ def plot_trajectories(results: Sequence[EvalResult], seeds: Sequence[int], path:
             scene = env.unwrapped.scene
             canvas = MapCanvas(scene, size)
             img = draw_scene(scene, canvas)
-            for i, r in enumerate(results):
+            for r in results:
                 episode = next(e for e in r.episodes if e.seed == seed)
-                color = tuple(int(255 * c) for c in COLORS[i % 10])
                 pts = np.array([canvas.px(x, y) for x, y in episode.trajectory], np.int32)
-                cv2.polylines(img, [pts], False, color, 2, cv2.LINE_AA)
+                cv2.polylines(img, [pts], False, method_color_255(r.policy), 2, cv2.LINE_AA)
             shown = next(e for e in first.episodes if e.seed == seed)
             radius = env.unwrapped.robot_config.body_radius
-            draw_pose(img, canvas, shown.home_pose, radius, HOME, filled=False)
-            draw_pose(img, canvas, shown.start_pose, radius, (120, 120, 120), filled=False)
+            draw_pose(img, canvas, shown.home_pose, radius, HOME_MARK, filled=False)
+            draw_pose(img, canvas, shown.start_pose, radius, START_MARK, filled=False)
+            draw_scale_bar(img, canvas)
             panels.append((seed, img))
     finally:
         env.close()
     cols = min(len(panels), 3)
     rows = (len(panels) + cols - 1) // cols
-    fig, axes = plt.subplots(rows, cols, figsize=(3.2 * cols, 3.2 * rows + 0.5), dpi=90,
+    fig, axes = plt.subplots(rows, cols, figsize=(3.2 * cols, 3.2 * rows + 0.7), dpi=90,
                              squeeze=False)
     for ax in axes.flat:
         ax.axis("off")
     for ax, (seed, img) in zip(axes.flat, panels):
         ax.imshow(img)
         ax.set_title(f"episode seed {seed}", fontsize=9)
-    handles = [plt.Line2D([], [], color=COLORS[i % 10], lw=2, label=r.policy)
-               for i, r in enumerate(results)]
-    handles += [plt.Line2D([], [], color=np.array(HOME) / 255, marker="o", ls="", mfc="none",
-                           label="home"),
-                plt.Line2D([], [], color="grey", marker="o", ls="", mfc="none", label="start")]
-    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8,
+    handles = [plt.Line2D([], [], color=method_color(r.policy), lw=2, label=r.policy)
+               for r in results]
+    handles += [plt.Line2D([], [], color=np.array(HOME_MARK) / 255, marker="o", ls="",
+                           mfc="none", label="home"),
+                plt.Line2D([], [], color=np.array(START_MARK) / 255, marker="o", ls="",
+                           mfc="none", label="start")]
+    fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 5), fontsize=8,
                frameon=False)
-    fig.tight_layout(rect=(0, 0.06, 1, 1))
+    fig.tight_layout(rect=(0, 0.12 if len(handles) > 5 else 0.07, 1, 1))
     fig.savefig(path)
     plt.close(fig)
 

@@ -36,13 +36,15 @@ import numpy as np  # noqa: E402
 from homing_gym.cli import command_parser  # noqa: E402
 from homing_gym.geometry import wrap_angle  # noqa: E402
 from homing_gym.scenes.base import clearance  # noqa: E402
-from homing_gym.topdown import HOME, MapCanvas, draw_pose, draw_scene  # noqa: E402
+from homing_gym.topdown import MapCanvas, draw_pose, draw_scale_bar, draw_scene  # noqa: E402
 from homing_train.harness.evaluate import (DEFAULT_ENV, add_policy_arguments,  # noqa: E402
                                            parse_json_kwargs, policy_from_args, run_episodes)
+from homing_train.harness.palette import HOME_MARK  # noqa: E402
 from homing_train.harness.policies import PolicySpec, policy_spec  # noqa: E402
 from homing_train.harness.rollout import prepare_policy, rollout  # noqa: E402
 
-RETURNED, FAILED, UNKNOWN = (40, 160, 60), (210, 50, 40), (40, 90, 200)
+# colour-blind-safe (Okabe & Ito): returned blue, not returned vermillion, unknown grey
+RETURNED, FAILED, UNKNOWN = (0, 114, 178), (213, 94, 0), (110, 110, 110)
 
 
 @dataclass
@@ -167,14 +169,17 @@ def plot_field(result: FieldResult, path: str, size: int = 480) -> None:
         tail = canvas.px(x - length / 2 * math.cos(c), y - length / 2 * math.sin(c))
         tip = canvas.px(x + length / 2 * math.cos(c), y + length / 2 * math.sin(c))
         cv2.arrowedLine(img, tail, tip, colour, 2, cv2.LINE_AA, tipLength=0.35)
-    draw_pose(img, canvas, result.home, 0.16, HOME, filled=False)
-    fig, ax = plt.subplots(figsize=(5, 5.4), dpi=100)
+    draw_pose(img, canvas, result.home, 0.16, HOME_MARK, filled=False)
+    draw_scale_bar(img, canvas)
+    fig, ax = plt.subplots(figsize=(5, 6.0), dpi=100)
     ax.imshow(img)
     ax.axis("off")
     title = (f"{result.policy}: AAE {result.aae_deg:.1f} deg, homeward "
-             f"{result.homeward:.2f}")
+             f"{result.homeward:.2f}\nAAE: average angle between commanded and true home "
+             f"direction;\nhomeward: its mean cosine; ring: home")
     if result.return_ratio is not None:
-        title += f"\nreturn ratio {100 * result.return_ratio:.0f}% (green: returned, red: not)"
+        title += (f"\nreturn ratio {100 * result.return_ratio:.0f}% "
+                  f"(blue: returned, vermillion: not)")
     ax.set_title(title, fontsize=10)
     fig.tight_layout()
     fig.savefig(path)
