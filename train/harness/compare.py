@@ -77,8 +77,14 @@ def wilson_interval(successes: int, n: int, confidence: float = 0.95) -> tuple[f
     return float(ci.low), float(ci.high)
 
 
-def _legend_outside(ax) -> None:
+def _finish(fig, ax, title: str, path: str) -> None:
+    """Title, grid, the legend outside the data; save and close."""
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3)
     ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
 
 
 def plot_success_vs_distance(results: Sequence[EvalResult], path: str) -> None:
@@ -101,12 +107,7 @@ def plot_success_vs_distance(results: Sequence[EvalResult], path: str) -> None:
     ax.set_xlabel("start distance from home (cm); n = episodes per bin")
     ax.set_ylabel("success rate (%)")
     ax.set_ylim(-3, 103)
-    ax.set_title("Success by start distance (bands: 95% Wilson intervals)", fontsize=9)
-    ax.grid(alpha=0.3)
-    _legend_outside(ax)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
+    _finish(fig, ax, "Success by start distance (bands: 95% Wilson intervals)", path)
 
 
 def plot_final_distance(results: Sequence[EvalResult], path: str) -> None:
@@ -120,12 +121,7 @@ def plot_final_distance(results: Sequence[EvalResult], path: str) -> None:
     ax.axvline(100 * radius, color="grey", ls="--", lw=1, label="success radius")
     ax.set_xlabel("final distance to home (cm)")
     ax.set_ylabel("fraction of episodes")
-    ax.set_title("Final distance to home (empirical CDF)", fontsize=9)
-    ax.grid(alpha=0.3)
-    _legend_outside(ax)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
+    _finish(fig, ax, "Final distance to home (empirical CDF)", path)
 
 
 def plot_trajectories(results: Sequence[EvalResult], seeds: Sequence[int], path: str,
