@@ -16,7 +16,8 @@
   sub-pixel peak.
 * :func:`triangulate`: §3(2): position and heading from the known 3-D coordinates of
   two or more rediscovered points and their apparent directions (bearing and elevation;
-  with the camera height known, two points fix the pose), by Gauss-Newton least squares.
+  with the camera height known, two points fix the pose), by least squares
+  (Levenberg-Marquardt).
 
 Image coordinates are continuous: column ``x`` in ``[0, W)`` with bearing
 ``pi - 2*pi*x/W`` (radians, CCW from the heading), pixel ``j`` covering ``[j, j + 1)``;
@@ -30,6 +31,7 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from scipy.optimize import least_squares
 
 from homing_gym.geometry import wrap_angle
 from homing_gym.panorama import column_bearing
@@ -168,34 +170,24 @@ def predicted_directions(pose, points, camera_height: float) -> tuple[np.ndarray
     return both[:len(pts)], both[len(pts):]
 
 
-def triangulate(points, bearings, elevations, camera_height: float, guess,
-                iterations: int = 30, tolerance: float = 1e-12) -> np.ndarray:
+def triangulate(points, bearings, elevations, camera_height: float, guess) -> np.ndarray:
     """The camera pose ``(x, y, yaw)`` (metres, radians) that best explains the observed
     ``bearings`` and ``elevations`` (radians) of known 3-D ``points`` ``(N, 3)``, N >= 2:
-    Gauss-Newton on the angle residuals (numerical Jacobian) from ``guess``."""
+    least squares on the angle residuals (bearing residuals wrapped to ``(-pi, pi]``) from
+    ``guess``, by Levenberg-Marquardt (``scipy.optimize.least_squares(method="lm")``)."""
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     if len(pts) < 2 or len(bearings) != len(pts) or len(elevations) != len(pts):
         raise ValueError(f"triangulation needs at least 2 points with one bearing and one "
                          f"elevation each, got {len(pts)} points, {len(bearings)} bearings, "
                          f"{len(elevations)} elevations")
     observed = np.concatenate([bearings, elevations]).astype(np.float64)
-    pose = np.asarray(guess, dtype=np.float64).copy()
 
     def residual(q):
         r = _predicted(q, pts, camera_height) - observed
         r[:len(pts)] = wrap_angle(r[:len(pts)])
         return r
 
-    for _ in range(iterations):
-        r = residual(pose)
-        jac = np.empty((len(r), 3))
-        for k in range(3):
-            dq = np.zeros(3)
-            dq[k] = 1e-7
-            jac[:, k] = (residual(pose + dq) - residual(pose - dq)) / 2e-7
-        step = np.linalg.lstsq(jac, -r, rcond=None)[0]
-        pose += step
-        if float(step @ step) < tolerance:
-            break
+    pose = least_squares(residual, np.asarray(guess, dtype=np.float64), method="lm",
+                         xtol=1e-12, ftol=1e-12).x
     pose[2] = wrap_angle(pose[2])
     return pose

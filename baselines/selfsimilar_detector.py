@@ -298,11 +298,9 @@ def _chains(rows: list[list[_Match]], cfg: DetectorConfig) -> list[list[_Match]]
 
 
 def _interp(gray: np.ndarray, y: int, xs: np.ndarray) -> np.ndarray:
-    """Row ``y`` of ``gray`` at fractional columns ``xs`` (clamped to the image)."""
-    xs = np.clip(xs, 0, gray.shape[1] - 1.001)
-    i = xs.astype(np.int64)
-    f = (xs - i).astype(np.float32)
-    return gray[y, i] * (1 - f) + gray[y, i + 1] * f
+    """Row ``y`` of ``gray`` at fractional columns ``xs`` (linear, ``np.interp``; the end
+    values beyond the image)."""
+    return np.interp(xs, np.arange(gray.shape[1]), gray[y]).astype(np.float32)
 
 
 def _extent(gray: np.ndarray, chain: list[_Match], a: float, b: float,

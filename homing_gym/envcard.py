@@ -26,7 +26,9 @@ def env_card(env_id: str) -> str:
               f"```python\nimport gymnasium as gym\nimport homing_gym\n\n"
               f"gym.register_envs(homing_gym)\nenv = gym.make(\"{env_id}\")\n```\n\n"
               f"| | |\n|---|---|\n| Entry point | `{spec.entry_point}` |\n"
-              f"| Max episode steps | {spec.max_episode_steps} |\n\n")
+              f"| Max episode steps | {spec.max_episode_steps} (`gym.make(..., "
+              f"max_episode_steps=N)` changes it; `-1` removes the time limit, Gymnasium's "
+              f"convention) |\n\n")
     return header + body + "\n"
 
 

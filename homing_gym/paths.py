@@ -2,23 +2,26 @@
 
 ``shortest_path(scene, start, goal, radius)`` returns the waypoints of a short
 collision-free path for a disc of ``radius`` metres: the straight segment when it is free
-(exact), otherwise an 8-connected A* path on an occupancy grid (``resolution`` metres)
-shortened by line-of-sight string pulling and then tightened like a taut string (any-angle; a few millimetres
-longer than the true shortest path). Obstacles are what :func:`homing_gym.scenes.base.clearance` sees:
+(exact), otherwise a shortest 8-connected path on an occupancy grid (``resolution``
+metres; Dijkstra from ``scipy.sparse.csgraph``) shortened by line-of-sight string pulling
+and then tightened like a taut string (any-angle; a few millimetres longer than the true
+shortest path). Obstacles are what :func:`homing_gym.scenes.base.clearance` sees:
 walls, landmarks and the scene bounds.
 """
 
 from __future__ import annotations
 
-import heapq
 import math
 from functools import lru_cache
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import dijkstra
 
 from homing_gym.scenes.base import Scene, clearances
 
-SQRT2 = math.sqrt(2.0)
+# the four forward steps (dx >= 0) of the 8-connected grid and their lengths (cells)
+_STEPS = ((1, 0, 1.0), (0, 1, 1.0), (1, 1, math.sqrt(2.0)), (1, -1, math.sqrt(2.0)))
 
 
 class NoPathError(ValueError):
@@ -79,7 +82,7 @@ def shortest_path(scene: Scene, start, goal, radius: float = 0.16,
     free = free.copy()  # a robot pushed near an obstacle may still leave: free its surroundings
     for c in (src, dst):
         free[max(0, c[0] - 3):c[0] + 4, max(0, c[1] - 3):c[1] + 4] = True
-    cells = _astar(free, src, dst)
+    cells = _grid_path(free, src, dst)
     if cells is None:
         raise NoPathError(f"no free path for radius {radius} m from {a} to {b} "
                           f"in scene {scene.name!r}")
@@ -88,42 +91,32 @@ def shortest_path(scene: Scene, start, goal, radius: float = 0.16,
     return _tighten(_subdivide(_string_pull(points, visible), 4 * resolution), visible)
 
 
-def _astar(free: np.ndarray, src, dst) -> list | None:
-    """8-connected A* on the grid; the start and goal cells count as free."""
+def _grid_path(free: np.ndarray, src, dst) -> list | None:
+    """Cells of a shortest 8-connected path from ``src`` to ``dst`` over ``free`` cells
+    (steps of 1 and sqrt(2) cells; ``dst`` counts as free): Dijkstra from
+    ``scipy.sparse.csgraph`` on the grid graph. ``None`` when they are not connected."""
     nx, ny = free.shape
-    steps = [(1, 0, 1.0), (-1, 0, 1.0), (0, 1, 1.0), (0, -1, 1.0),
-             (1, 1, SQRT2), (1, -1, SQRT2), (-1, 1, SQRT2), (-1, -1, SQRT2)]
-
-    def h(c) -> float:
-        dx, dy = abs(c[0] - dst[0]), abs(c[1] - dst[1])
-        return max(dx, dy) + (SQRT2 - 1) * min(dx, dy)
-
-    g = {src: 0.0}
-    parent = {src: None}
-    heap = [(h(src), src)]
-    done = set()
-    while heap:
-        _, c = heapq.heappop(heap)
-        if c == dst:
-            path = [c]
-            while parent[path[-1]] is not None:
-                path.append(parent[path[-1]])
-            return path[::-1]
-        if c in done:
-            continue
-        done.add(c)
-        for dx, dy, cost in steps:
-            n = (c[0] + dx, c[1] + dy)
-            if not (0 <= n[0] < nx and 0 <= n[1] < ny) or n in done:
-                continue
-            if not free[n] and n != dst:
-                continue
-            ng = g[c] + cost
-            if ng < g.get(n, math.inf):
-                g[n] = ng
-                parent[n] = c
-                heapq.heappush(heap, (ng + h(n), n))
-    return None
+    free = free.copy()
+    free[dst] = True
+    index = np.arange(nx * ny).reshape(nx, ny)
+    rows, cols, costs = [], [], []
+    for dx, dy, cost in _STEPS:
+        a = (slice(0, nx - dx), slice(max(0, -dy), ny - max(0, dy)))
+        b = (slice(dx, nx), slice(max(0, dy), ny - max(0, -dy)))
+        both = free[a] & free[b]
+        rows.append(index[a][both])
+        cols.append(index[b][both])
+        costs.append(np.full(int(both.sum()), cost))
+    graph = coo_matrix((np.concatenate(costs), (np.concatenate(rows), np.concatenate(cols))),
+                       shape=(nx * ny, nx * ny)).tocsr()
+    source, target = int(index[src]), int(index[dst])
+    dist, parent = dijkstra(graph, directed=False, indices=source, return_predecessors=True)
+    if not np.isfinite(dist[target]):
+        return None
+    path = [target]
+    while path[-1] != source:
+        path.append(int(parent[path[-1]]))
+    return [divmod(i, ny) for i in reversed(path)]
 
 
 def _string_pull(points: list, visible) -> list:

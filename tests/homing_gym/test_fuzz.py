@@ -1,11 +1,17 @@
-"""Fuzz: a seeded sample of bad constructor arguments and actions for every env id, each
-case in its own subprocess with a timeout, must end in a clear error.
+"""Fuzz: a seeded sample of bad constructor arguments and actions for every env id, and
+bad inputs to every command, each case in its own subprocess with a timeout, must end in
+a clear error.
 
-Each case makes the env, resets it and steps it; the outcome is one of ``clear`` (a
+An env case makes the env, resets it and steps it; the outcome is one of ``clear`` (a
 ``ValueError``/``TypeError`` or Gymnasium error naming the problem), ``accepted`` (no error:
 for a bad input, silently accepted), ``deep`` (any other exception, from deep inside
-PyBullet or numpy), ``crash`` (the process died) or ``hang`` (past the timeout).
+PyBullet or numpy), ``crash`` (the process died) or ``hang`` (past the timeout). A command
+case is ``clear`` when the command exits with status 2 and says ``error:`` without a
+traceback, ``accepted`` when it exits 0, ``crash`` for any other ending.
 ``python tests/homing_gym/test_fuzz.py`` prints the counts.
+
+Documented acceptance: ``gym.make(..., max_episode_steps=-1)`` is Gymnasium's way of
+asking for no time limit (the env cards in ``docs/envs/``), so it is not counted as a bad input.
 """
 
 from __future__ import annotations
@@ -13,6 +19,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+import tempfile
 from collections import Counter
 from concurrent.futures import ThreadPoolExecutor
 
@@ -36,6 +43,39 @@ BAD_KWARGS = [
     {"scene": "nowhere"}, {"scene": 5}, {"reward": {"nope": 1}},
     {"reward": {"progress": "x"}}, {"reward": {"progress": NAN}}, {"stop_threshold": 2},
     {"vfov_deg": 500}, {"renderer": "nope"}, {"omni_size": 3},
+    {"max_episode_steps": 0}, {"max_episode_steps": 2.5},
+]
+BAD_COMMANDS = [   # (module of the command, arguments)
+    ("homing_train.harness.evaluate", ["--policy", "nope", "--out", "{tmp}/r.json"]),
+    ("homing_train.harness.evaluate", ["--policy", "random", "--episodes", "0",
+                                       "--out", "{tmp}/r.json"]),
+    ("homing_train.harness.evaluate", ["--policy", "random", "--env", "nope/Nope-v0",
+                                       "--out", "{tmp}/r.json"]),
+    ("homing_train.harness.evaluate", ["--policy", "random", "--env-kwargs", "{bad json",
+                                       "--out", "{tmp}/r.json"]),
+    ("homing_train.harness.evaluate", ["--policy", "random", "--workers", "2", "--env-kwargs",
+                                       '{"scene": "nowhere"}', "--out", "{tmp}/r.json"]),
+    ("homing_train.harness.evaluate", ["--policy", "random", "--param", "no_equals_sign",
+                                       "--out", "{tmp}/r.json"]),
+    ("homing_train.harness.evaluate", ["--policy", "{tmp}/missing.zip", "--out",
+                                       "{tmp}/r.json"]),
+    ("homing_train.harness.evaluate", ["--policy", "random", "--out", "/proc/none/r.json"]),
+    ("homing_train.harness.evaluate", ["--policy", "random", "--workers", "0",
+                                       "--out", "{tmp}/r.json"]),
+    ("homing_train.harness.evaluate", ["--policy", "random", "--import", "no_such_module",
+                                       "--out", "{tmp}/r.json"]),
+    ("homing_train.harness.suite", ["--methods", "nope", "--out", "{tmp}/suite"]),
+    ("homing_train.harness.suite", ["--episodes", "0", "--out", "{tmp}/suite"]),
+    ("homing_train.harness.field", ["--policy", "nope", "--out", "{tmp}/f.png"]),
+    ("homing_train.harness.field", ["--policy", "warping", "--grid", "-1",
+                                    "--out", "{tmp}/f.png"]),
+    ("homing_train.harness.compare", ["{tmp}/missing.json", "--out", "{tmp}/cmp"]),
+    ("homing_train.harness.demo", ["--scene", "nowhere", "--out", "{tmp}/demo"]),
+    ("homing_train.learning.train", ["--env", "nope/Nope-v0", "--out", "{tmp}/run"]),
+    ("homing_train.learning.train", ["--timesteps", "-5", "--out", "{tmp}/run"]),
+    ("homing_train.learning.train", ["--hp", "n_stepz=64", "--out", "{tmp}/run"]),
+    ("homing_gym.benchmark", ["--steps", "0"]),
+    ("homing_gym.benchmark", ["--renderers", "nope"]),
 ]
 BAD_ACTIONS = {"continuous": [[NAN, 0], [INF, 0], None, "forward", [1, 2, 3], [True, False],
                               {"complex": [0.5, 1]}],
@@ -65,7 +105,7 @@ except Exception as err:
 """
 
 
-def cases(n_kwargs: int = 40, seed: int = 0) -> list[dict]:
+def cases(n_kwargs: int = 50, seed: int = 0) -> list[dict]:
     """A seeded sample of constructor cases over the env ids, and every bad action."""
     rng = np.random.default_rng(seed)
     out = [{"env_id": ENV_IDS[int(rng.integers(len(ENV_IDS)))],
@@ -93,10 +133,33 @@ def run_case(case: dict, timeout: float = 60.0) -> tuple[str, str]:
     return outcome, message
 
 
+def run_command_case(case: dict, timeout: float = 120.0) -> tuple[str, str]:
+    """``(outcome, message)`` of one command case (``{"module", "args"}``) in a fresh
+    interpreter, its output files under a temporary folder."""
+    with tempfile.TemporaryDirectory() as tmp:
+        args = [a.replace("{tmp}", tmp) for a in case["args"]]
+        try:
+            out = subprocess.run([sys.executable, "-m", case["module"], *args],
+                                 capture_output=True, text=True, timeout=timeout, cwd=tmp)
+        except subprocess.TimeoutExpired:
+            return "hang", f"no answer in {timeout} s"
+    last = (out.stderr.strip().splitlines() or [""])[-1]
+    if out.returncode == 0:
+        return "accepted", out.stdout.strip()[-160:]
+    if out.returncode == 2 and "error:" in last and "Traceback" not in out.stderr:
+        return "clear", last
+    return "crash", f"exit {out.returncode}: {last}"
+
+
+def command_cases() -> list[dict]:
+    return [{"module": module, "args": args} for module, args in BAD_COMMANDS]
+
+
 def run_all(workers: int = 2) -> list[tuple[dict, str, str]]:
-    sample = cases()
+    sample = cases() + command_cases()
+    run = lambda case: (run_command_case if "module" in case else run_case)(case)  # noqa: E731
     with ThreadPoolExecutor(workers) as pool:
-        results = list(pool.map(run_case, sample))
+        results = list(pool.map(run, sample))
     return [(case, *result) for case, result in zip(sample, results)]
 
 
@@ -106,6 +169,23 @@ def test_every_bad_input_gets_a_clear_error():
     bad = [(case, outcome, message) for case, outcome, message in results
            if outcome != "clear"]
     assert bad == [], "\n".join(f"{o}: {c} -> {m}" for c, o, m in bad)
+
+
+def test_max_episode_steps_minus_one_is_gymnasiums_no_time_limit():
+    import gymnasium as gym
+
+    import homing_gym  # noqa: F401
+
+    env = gym.make("homing_gym/LocalHoming-v0", max_episode_steps=-1,
+                   panorama_shape=(16, 64))
+    try:
+        assert env.spec.max_episode_steps is None
+        wrapper = env
+        while wrapper is not env.unwrapped:
+            assert not isinstance(wrapper, gym.wrappers.TimeLimit)
+            wrapper = wrapper.env
+    finally:
+        env.close()
 
 
 if __name__ == "__main__":

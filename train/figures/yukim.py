@@ -43,6 +43,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from scipy import stats  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
 import homing_baselines  # noqa: E402
@@ -54,6 +55,7 @@ from homing_gym.cli import command_parser  # noqa: E402
 from homing_gym.geometry import wrap_angle  # noqa: E402
 from homing_gym.scenes.base import clearance  # noqa: E402
 from homing_gym.topdown import HOME, MapCanvas, draw_pose, draw_scene  # noqa: E402
+from homing_train.harness.metrics import wilson_interval  # noqa: E402
 
 ENV_ID = "homing_gym/LocalHoming-v0"
 HOME_POSE = (0.0, 0.0, 0.0)  # the nest: arena centre, among the four cylinders
@@ -69,33 +71,12 @@ def register_controllers() -> None:
             homing_baselines.register(name, cls)
 
 
-def t_quantile(p: float, dof: int) -> float:
-    """Student-t quantile (no SciPy): bisection on the CDF integrated numerically."""
-    if dof < 1:
-        return math.nan
-    x = np.linspace(0, 60, 600001)
-    logc = math.lgamma((dof + 1) / 2) - math.lgamma(dof / 2) - 0.5 * math.log(dof * math.pi)
-    pdf = np.exp(logc - (dof + 1) / 2 * np.log1p(x ** 2 / dof))
-    cdf = 0.5 + np.concatenate([[0], np.cumsum((pdf[1:] + pdf[:-1]) / 2 * np.diff(x))])
-    return float(np.interp(p, cdf, x))
-
-
-def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
-    """95% Wilson score interval of a success proportion k / n."""
-    if n == 0:
-        return math.nan, math.nan
-    p = k / n
-    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return max(0.0, centre - half), min(1.0, centre + half)
-
-
 def mean_ci(values: np.ndarray) -> tuple[float, float]:
     """Mean and half-width of its 95% Student-t interval."""
     v = np.asarray(values, np.float64)
     if v.size < 2:
         return (float(v.mean()) if v.size else math.nan), math.nan
-    return float(v.mean()), t_quantile(0.975, v.size - 1) * float(v.std(ddof=1)) / math.sqrt(v.size)
+    return float(v.mean()), float(stats.t.ppf(0.975, v.size - 1) * stats.sem(v))
 
 
 @dataclass
@@ -355,7 +336,7 @@ def run_success(out: str, trials: int, workers: int, seed: int, bins=FIG6_BINS,
             ok = np.array([r.success for r in recs], float)
             k, n = int(ok.sum()), len(ok)
             rows.append({"lo": lo, "hi": hi, "trials": n, "successes": k,
-                         "success_rate": k / n, "success_ci": list(wilson(k, n)),
+                         "success_rate": k / n, "success_ci": list(wilson_interval(k, n)),
                          "collisions_mean": float(np.mean([r.collisions for r in recs])),
                          "final_distance_mean": float(np.mean([r.final_distance for r in recs])),
                          "steps_mean": float(np.mean([r.steps for r in recs]))})

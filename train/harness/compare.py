@@ -69,14 +69,6 @@ def check_paired(results: Sequence[EvalResult]) -> list[int]:
     return shared
 
 
-def wilson_interval(successes: int, n: int, confidence: float = 0.95) -> tuple[float, float]:
-    """Wilson score interval of a success rate (``scipy.stats.binomtest``)."""
-    from scipy.stats import binomtest
-
-    ci = binomtest(successes, n).proportion_ci(confidence_level=confidence, method="wilson")
-    return float(ci.low), float(ci.high)
-
-
 def _finish(fig, ax, title: str, path: str) -> None:
     """Title, grid, the legend outside the data; save and close."""
     ax.set_title(title, fontsize=9)
@@ -94,9 +86,8 @@ def plot_success_vs_distance(results: Sequence[EvalResult], path: str) -> None:
     for r in results:
         bins = r.summary["success_by_distance"]
         x = np.array([100 * (b["lo"] + b["hi"]) / 2 for b in bins])
-        k = [round(b["success_rate"] * b["n"]) for b in bins]
         y = np.array([100 * b["success_rate"] for b in bins])
-        lo, hi = np.array([wilson_interval(ki, b["n"]) for ki, b in zip(k, bins)]).T * 100
+        lo, hi = np.array([b["success_ci"] for b in bins]).T * 100
         color = method_color(r.policy)
         ax.plot(x, y, marker="o", color=color, label=r.policy)
         ax.fill_between(x, lo, hi, color=color, alpha=0.12, lw=0)

@@ -88,10 +88,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=9)
     parser.add_argument("--scene", default="arena")
     args = parser.parse_args(argv)
+    try:
+        env = gym.make("homing_gym/LocalHoming-v0", scene=args.scene, render_mode="rgb_array",
+                       obs_keys=("panorama", "goal", "omni", "signature"))
+    except ValueError as err:
+        parser.error(str(err))
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    env = gym.make("homing_gym/LocalHoming-v0", scene=args.scene, render_mode="rgb_array",
-                   obs_keys=("panorama", "goal", "omni", "signature"))
     try:
         frames, info = run_episode(env, args.seed)
         imageio.imwrite(out / "demo.png", frames[-1])

@@ -143,7 +143,8 @@ def write_csv(episodes: Sequence[EpisodeRecord], path: str) -> None:
 
 def summarize(episodes: Sequence[EpisodeRecord], bin_width: float = 0.3,
               seed: int = 0) -> dict[str, Any]:
-    """Means with 95% bootstrap CIs (seeded) and success by start-distance bin."""
+    """Means with 95% CIs (success: Wilson; the others: seeded percentile bootstrap of the
+    mean) and success by start-distance bin."""
     if not episodes:
         raise ValueError("no episodes to summarize")
 
@@ -159,7 +160,8 @@ def summarize(episodes: Sequence[EpisodeRecord], bin_width: float = 0.3,
         values = col(name)
         out[key] = float(values.mean())
         ci_key = "success_ci" if key == "success_rate" else key.removesuffix("_mean") + "_ci"
-        out[ci_key] = list(metrics.bootstrap_ci(values, seed=seed))
+        out[ci_key] = list(metrics.wilson_interval(int(values.sum()), values.size)
+                           if key == "success_rate" else metrics.bootstrap_ci(values, seed=seed))
     final_cm = 100 * col("final_distance")
     out["final_distance_cm_median"] = float(np.median(final_cm))
     out["heading_error_deg_median"] = float(np.median(col("final_heading_error_deg")))
@@ -167,7 +169,7 @@ def summarize(episodes: Sequence[EpisodeRecord], bin_width: float = 0.3,
     out["wall_time_mean"] = float(col("wall_time").mean())
     out["bin_width"] = bin_width
     out["success_by_distance"] = [asdict(b) for b in metrics.distance_bins(
-        col("start_distance"), col("success"), bin_width, seed=seed)]
+        col("start_distance"), col("success"), bin_width)]
     return out
 
 

@@ -17,12 +17,16 @@ from __future__ import annotations
 import json
 import math
 import multiprocessing
+import os
 import platform
 import re
 import shlex
+import shutil
 import signal
 import sys
+import tempfile
 import time
+import traceback
 from dataclasses import asdict, dataclass, field, fields
 from functools import partial
 from importlib import resources
@@ -78,8 +82,9 @@ class TrainConfig:
     ppo: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        if self.env_id not in homing_gym.ENV_IDS:
-            raise ValueError(f"unknown env {self.env_id!r}; allowed: {list(homing_gym.ENV_IDS)}")
+        if self.env_id not in gym.registry:     # homing-gym's ids, or a user's (--import)
+            raise ValueError(f"unknown env {self.env_id!r}; homing-gym ids: "
+                             f"{list(homing_gym.ENV_IDS)} (or register yours, --import MODULE)")
         if self.vec not in ("subproc", "dummy"):
             raise ValueError(f"--vec must be 'subproc' or 'dummy', got {self.vec!r}")
         if self.extractor not in EXTRACTORS:
@@ -146,28 +151,77 @@ def make_config(env_id: str, settings: dict[str, Any], **flags: Any) -> TrainCon
     return TrainConfig(env_id=env_id, ppo=ppo, **settings)
 
 
-def make_env(env_id: str, env_kwargs: dict[str, Any]) -> gym.Env:
+class EnvWorkerError(RuntimeError):
+    """An env in a subprocess worker raised: the message is the worker's own error (SB3's
+    ``SubprocVecEnv`` would only say ``EOFError``)."""
+
+
+class _ReportErrors(gym.Wrapper):
+    """In a worker process: an error from ``reset``/``step`` is written to ``path`` (its
+    type, message and traceback) and the worker exits quietly, so that the main process
+    says that error once instead of SB3's ``EOFError`` and a second traceback."""
+
+    def __init__(self, env: gym.Env, path: Path):
+        super().__init__(env)
+        self._path = path
+
+    def _fail(self, err: Exception) -> None:
+        self._path.write_text(f"{type(err).__name__}: {err}\n\n{traceback.format_exc()}")
+        os._exit(1)
+
+    def reset(self, **kwargs):
+        try:
+            return self.env.reset(**kwargs)
+        except Exception as err:  # noqa: BLE001 (reported to the main process)
+            self._fail(err)
+
+    def step(self, action):
+        try:
+            return self.env.step(action)
+        except Exception as err:  # noqa: BLE001 (reported to the main process)
+            self._fail(err)
+
+
+def make_env(env_id: str, env_kwargs: dict[str, Any], report_dir: str | None = None) -> gym.Env:
     """A single env (top-level, so that subprocess workers can unpickle it). In a worker
     process Ctrl-C is left to the main process, which saves the run and closes the
-    workers."""
+    workers, and an env error is written to ``report_dir`` for the main process to say
+    (:class:`EnvWorkerError`)."""
     import homing_gym  # noqa: F401  (registers the ids in a spawned worker)
 
+    env = gym.make(env_id, **env_kwargs)
     if multiprocessing.current_process().name != "MainProcess":
         signal.signal(signal.SIGINT, signal.SIG_IGN)
-    return gym.make(env_id, **env_kwargs)
+        if report_dir is not None:
+            env = _ReportErrors(env, Path(report_dir) / f"worker_{os.getpid()}.txt")
+    return env
 
 
-def make_vec(config: TrainConfig, n_envs: int, seed: int):
+def worker_error(report_dir: Path) -> EnvWorkerError | None:
+    """The first error a worker wrote to ``report_dir`` (its one-line summary as the
+    message, the traceback in ``details``), or ``None``."""
+    reports = sorted(report_dir.glob("worker_*.txt"))
+    if not reports:
+        return None
+    text = reports[0].read_text()
+    error = EnvWorkerError(f"an env worker failed: {text.splitlines()[0]}")
+    error.details = text
+    return error
+
+
+def make_vec(config: TrainConfig, n_envs: int, seed: int, report_dir: Path | None = None):
     """A monitored vector env of ``n_envs`` copies (success logged from ``is_success``),
-    images transposed to channel-first."""
+    images transposed to channel-first; subprocess workers write their errors to
+    ``report_dir``."""
     from stable_baselines3.common.env_util import make_vec_env
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecTransposeImage
 
     vec_cls, vec_kwargs = DummyVecEnv, None
     if config.vec == "subproc" and n_envs > 1:
         vec_cls, vec_kwargs = SubprocVecEnv, {"start_method": "spawn"}
-    env = make_vec_env(partial(make_env, config.env_id, config.env_kwargs), n_envs=n_envs,
-                       seed=seed, vec_env_cls=vec_cls, vec_env_kwargs=vec_kwargs,
+    env = make_vec_env(partial(make_env, config.env_id, config.env_kwargs,
+                               None if report_dir is None else str(report_dir)),
+                       n_envs=n_envs, seed=seed, vec_env_cls=vec_cls, vec_env_kwargs=vec_kwargs,
                        monitor_kwargs={"info_keywords": ("is_success",)})
     return VecTransposeImage(env)      # channel-first images, as SB3 would wrap them itself
 
@@ -326,7 +380,8 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
     checkpoint = latest_checkpoint(out) if resume else None
     # a resumed run draws new training episodes: its envs are seeded past the steps done
     done_steps = checkpoint_steps(checkpoint) if checkpoint is not None else 0
-    env = make_vec(config, config.n_envs, config.seed + done_steps)
+    report_dir = Path(tempfile.mkdtemp(prefix="homing-train-workers-"))
+    env = make_vec(config, config.n_envs, config.seed + done_steps, report_dir)
     eval_env = make_vec(TrainConfig(**{**asdict(config), "vec": "dummy"}), 1,
                         config.seed + EVAL_SEED_OFFSET)
     try:
@@ -377,6 +432,11 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
                 fresh = False
         except KeyboardInterrupt:           # Ctrl-C: keep what was learned, say so
             interrupted = True
+        except (EOFError, BrokenPipeError, ConnectionResetError) as err:
+            error = worker_error(report_dir)
+            if error is None:
+                raise
+            raise error from err
         set_actor_trainable(model.policy, True)
         wall = time.perf_counter() - t0
         model.save(out / "model.zip")
@@ -400,7 +460,8 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
             try:
                 vec.close()
             except (EOFError, BrokenPipeError, ConnectionResetError):
-                pass                        # workers already gone after Ctrl-C
+                pass                        # workers already gone after Ctrl-C or an error
+        shutil.rmtree(report_dir, ignore_errors=True)
     return model
 
 
@@ -448,7 +509,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(str(err))
     try:
         train(config, run, resume=bool(args.resume), progress=not args.no_progress)
-    except ValueError as err:
+    except (ValueError, EnvWorkerError) as err:
         parser.exit(2, f"homing-train: error: {err}\n")
     summary = json.loads((run / "summary.json").read_text())
     if summary.get("interrupted"):

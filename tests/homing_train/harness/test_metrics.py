@@ -8,7 +8,8 @@ import pytest
 from homing_gym.paths import segment_free, shortest_path
 from homing_gym.scenes.arena import arena_scene
 from homing_train.harness.evaluate import EpisodeRecord, summarize
-from homing_train.harness.metrics import bootstrap_ci, distance_bins, path_length, soft_spl, spl
+from homing_train.harness.metrics import (bootstrap_ci, distance_bins, path_length, soft_spl, spl,
+                                          wilson_interval)
 
 # a 3-4-5 detour: straight-line distance 5, travelled 7
 TRAJECTORY = [(0.0, 0.0), (3.0, 0.0), (3.0, 4.0)]
@@ -60,6 +61,16 @@ def test_bootstrap_ci_matches_normal_approximation_and_is_seeded():
     assert bootstrap_ci(x, seed=3) == (lo, hi)
 
 
+def test_wilson_interval_against_hand_computed_values():
+    # k = 5 of n = 10: centre 0.5, half-width z sqrt(p(1-p)/n + z^2/4n^2) / (1 + z^2/n)
+    assert wilson_interval(5, 10) == pytest.approx((0.2366, 0.7634), abs=1e-3)
+    assert wilson_interval(0, 10) == pytest.approx((0.0, 0.2775), abs=1e-3)
+    assert wilson_interval(10, 10) == pytest.approx((0.7225, 1.0), abs=1e-3)
+    assert all(math.isnan(v) for v in wilson_interval(0, 0))
+    with pytest.raises(ValueError, match="successes"):
+        wilson_interval(11, 10)
+
+
 def _record(seed, success, start_distance, spl_value, final_distance=0.1):
     return EpisodeRecord(seed=seed, start_pose=[0, 0, 0], home_pose=[1, 0, 0],
                          start_distance=start_distance, shortest_path=start_distance,
@@ -78,8 +89,7 @@ def test_summary_means_and_bins():
     assert s["spl"] == pytest.approx(1.4 / 3)
     assert s["final_distance_mean"] == pytest.approx(0.5 / 3)
     assert s["final_distance_cm_median"] == pytest.approx(10.0)
-    lo, hi = s["success_ci"]
-    assert 0 <= lo <= 2 / 3 <= hi <= 1
+    assert s["success_ci"] == list(wilson_interval(2, 3))
     assert [(b["lo"], b["n"], b["success_rate"]) for b in s["success_by_distance"]] == [
         (0.3, 2, 0.5), (0.9, 1, 1.0)]
 

@@ -259,8 +259,8 @@ def test_ctrl_c_saves_the_run_and_resume_continues_with_new_episode_seeds(tmp_pa
     seeds = []
     real_make_vec = train_module.make_vec
     monkeypatch.setattr(train_module, "make_vec",
-                        lambda config, n, seed: seeds.append(seed) or real_make_vec(config, n,
-                                                                                     seed))
+                        lambda config, n, seed, *rest: seeds.append(seed)
+                        or real_make_vec(config, n, seed, *rest))
     assert main(["--resume", str(run), "--timesteps", "256", "--no-progress"]) == 0
     config_seed = yaml.safe_load((run / "config.yml").read_text())["seed"]
     assert seeds[0] == config_seed + 128          # training envs: not the first run's seeds
@@ -278,3 +278,36 @@ def test_a_bad_env_setting_is_one_error_and_leaves_no_run_folder(tmp_path, capsy
     assert exit_.value.code == 2
     err = capsys.readouterr().err
     assert err.count("unknown scene 'nowhere'") == 1 and not run.exists()
+
+
+@pytest.mark.slow
+def test_an_env_error_in_a_subprocess_worker_is_said_once_not_as_eoferror(tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    # a user env that fails at its 5th step, registered through --import in every worker
+    (tmp_path / "failing_env.py").write_text(
+        "import gymnasium as gym\n"
+        "class FailAtStep5(gym.Wrapper):\n"
+        "    steps = 0\n"
+        "    def step(self, action):\n"
+        "        self.steps += 1\n"
+        "        if self.steps == 5:\n"
+        "            raise ValueError('boom: the user env failed at step 5')\n"
+        "        return self.env.step(action)\n"
+        "def make(**kwargs):\n"
+        "    return FailAtStep5(gym.make('homing_gym/LocalHoming-v0', **kwargs).unwrapped)\n"
+        "gym.register('failing/LocalHoming-v0', entry_point=make, max_episode_steps=16)\n")
+    env = {**os.environ, "PYTHONPATH": str(tmp_path)}
+    run = tmp_path / "run"
+    tiny = [a if a != "dummy" else "subproc" for a in TINY]
+    tiny[tiny.index("--n-envs") + 1] = "2"
+    done = subprocess.run([sys.executable, "-m", "homing_train.learning.train", "--import",
+                           "failing_env", "--env", "failing/LocalHoming-v0", "--timesteps", "64",
+                           "--out", str(run), *tiny], capture_output=True, text=True, env=env,
+                          timeout=300)
+    assert done.returncode == 2, done.stderr[-2000:]
+    assert done.stderr.count("boom: the user env failed at step 5") == 1, done.stderr[-3000:]
+    assert "ValueError" in done.stderr and "EOFError" not in done.stderr
+    assert "Traceback" not in done.stderr
