@@ -43,9 +43,12 @@ panorama alike (columns wrap around in a panorama).
 from __future__ import annotations
 
 import math
+import statistics
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
+from numba import njit
 
 from homing_baselines.camera_models import CameraModel
 from homing_gym.geometry import wrap_angle
@@ -150,13 +153,72 @@ def to_gray(image: np.ndarray) -> np.ndarray:
     return luminance(image)
 
 
-def _taps(p: float, w: int) -> list[tuple[int, int, float, int, float]]:
-    """For each ``xi`` in ``1 .. w-1``: ``xi``, then floor and fraction of ``sqrt(p) xi``
-    and of ``p xi`` (the interpolation taps of Eq. 7)."""
-    out = []
-    for xi in range(1, w):
-        s, q = math.sqrt(p) * xi, p * xi
-        out.append((xi, int(s), s - int(s), int(q), q - int(q)))
+@lru_cache(maxsize=32)
+def _taps(p: float, w: int) -> tuple[np.ndarray, ...]:
+    """The interpolation taps of Eq. 7 for ``xi = 1 .. w-1``: ``xi``; floor ``a`` of
+    ``sqrt(p) xi`` and its two weights ``1 - f``, ``f`` (float32); floor ``b`` of ``p xi``
+    and its two weights. (``xi = 0`` adds nothing: both differences are 0.)"""
+    xi = np.arange(1, w, dtype=np.int64)
+    s, q = math.sqrt(p) * xi, p * xi
+    a, b = s.astype(np.int64), q.astype(np.int64)
+    fa, fb = s - a, q - b
+    f32 = np.float32
+    return (xi, a, (1 - fa).astype(f32), fa.astype(f32), b, (1 - fb).astype(f32),
+            fb.astype(f32))
+
+
+# The kernels below are compiled with numba (cached on disk). Their arithmetic is float32
+# and in the order of Eq. 7 (for each xi: |I(x+xi) - I(x+sqrt(p) xi)| - |I(x+xi) - I(x+p xi)|,
+# summed over xi, divided by w), the same as numpy's on float32 arrays, so the values
+# and every decision taken on them are those of a plain numpy implementation.
+@njit(cache=True)
+def _m_at(row, x, w, xi, a, wa0, wa1, b, wb0, wb1):
+    """``m_y(x)`` of Eq. 7 on one scanline ``row`` (float32) at integer ``x``."""
+    acc = np.float32(0.0)
+    for t in range(xi.size):
+        base = row[x + xi[t]]
+        similar = row[x + b[t]] * wb0[t] + row[x + b[t] + 1] * wb1[t]
+        anti = row[x + a[t]] * wa0[t] + row[x + a[t] + 1] * wa1[t]
+        acc += abs(base - anti) - abs(base - similar)
+    return acc / np.float32(w)
+
+
+@njit(cache=True)
+def _m_strided(row, n, step, w, xi, a, wa0, wa1, b, wb0, wb1):
+    """``m_y(x)`` at ``x = 0, step, .. (n-1) step`` (taps outer, positions inner: the
+    inner loop is vectorised by the compiler)."""
+    acc = np.zeros(n, np.float32)
+    for t in range(xi.size):
+        o, oa, ob = xi[t], a[t], b[t]
+        ca0, ca1, cb0, cb1 = wa0[t], wa1[t], wb0[t], wb1[t]
+        for i in range(n):
+            x = i * step
+            base = row[x + o]
+            similar = row[x + ob] * cb0 + row[x + ob + 1] * cb1
+            anti = row[x + oa] * ca0 + row[x + oa + 1] * ca1
+            acc[i] += abs(base - anti) - abs(base - similar)
+    for i in range(n):
+        acc[i] = acc[i] / np.float32(w)
+    return acc
+
+
+@njit(cache=True)
+def _m_rows(rows, step, w, xi, a, wa0, wa1, b, wb0, wb1):
+    nx = rows.shape[1] - w + 1
+    n = (nx + step - 1) // step
+    out = np.zeros((rows.shape[0], n), np.float32)
+    for r in range(rows.shape[0]):
+        out[r] = _m_strided(rows[r], n, step, w, xi, a, wa0, wa1, b, wb0, wb1)
+    return out
+
+
+@njit(cache=True)
+def _m_points(gray, ys, xs, w, xi, a, wa0, wa1, b, wb0, wb1):
+    out = np.full(xs.size, np.float32(-1.0))
+    for i in range(xs.size):
+        x, y = xs[i], ys[i]
+        if x >= 0 and x + w <= gray.shape[1] and y >= 0 and y < gray.shape[0]:
+            out[i] = _m_at(gray[y], x, w, xi, a, wa0, wa1, b, wb0, wb1)
     return out
 
 
@@ -164,37 +226,20 @@ def match_function(rows: np.ndarray, p: float = DEFAULT_P, w: int = 45,
                    step: int = 1) -> np.ndarray:
     """``m_y(x)`` of Eq. 7 for each row of ``rows`` (``(R, n)`` intensities in [0, 1])
     at ``x = 0, step, 2 step, ...`` up to ``n - w``: ``(R, ceil((n - w + 1)/step))``."""
-    rows = np.atleast_2d(np.asarray(rows, dtype=np.float32))
-    nx = rows.shape[1] - w + 1
-    if nx <= 0:
+    rows = np.ascontiguousarray(np.atleast_2d(np.asarray(rows, dtype=np.float32)))
+    if rows.shape[1] - w + 1 <= 0:
         return np.zeros((rows.shape[0], 0), np.float32)
-    acc = np.zeros((rows.shape[0], len(range(0, nx, step))), np.float32)
-    for xi, a, fa, b, fb in _taps(p, w):
-        base = rows[:, xi:xi + nx:step]
-        similar = rows[:, b:b + nx:step] * (1 - fb) + rows[:, b + 1:b + 1 + nx:step] * fb
-        anti = rows[:, a:a + nx:step] * (1 - fa) + rows[:, a + 1:a + 1 + nx:step] * fa
-        acc += np.abs(base - anti) - np.abs(base - similar)
-    return acc / w
+    return _m_rows(rows, step, w, *_taps(p, w))
 
 
 def match_points(gray: np.ndarray, ys, xs, p: float = DEFAULT_P, w: int = 45) -> np.ndarray:
     """``m_y(x)`` of Eq. 7 at integer points ``(xs, ys)``; ``-1`` where the window
     leaves the image."""
-    ys = np.asarray(ys, dtype=np.int64)
     xs = np.asarray(xs, dtype=np.int64)
-    out = np.full(xs.shape, -1.0, np.float32)
-    ok = (xs >= 0) & (xs + w <= gray.shape[1]) & (ys >= 0) & (ys < gray.shape[0])
-    if not ok.any():
-        return out
-    y, x = ys[ok], xs[ok]
-    acc = np.zeros(x.shape, np.float32)
-    for xi, a, fa, b, fb in _taps(p, w):
-        base = gray[y, x + xi]
-        similar = gray[y, x + b] * (1 - fb) + gray[y, x + b + 1] * fb
-        anti = gray[y, x + a] * (1 - fa) + gray[y, x + a + 1] * fa
-        acc += np.abs(base - anti) - np.abs(base - similar)
-    out[ok] = acc / w
-    return out
+    ys = np.broadcast_to(np.asarray(ys, dtype=np.int64), xs.shape)
+    out = _m_points(np.ascontiguousarray(gray, dtype=np.float32), ys.ravel(), xs.ravel(), w,
+                    *_taps(p, w))
+    return out.reshape(xs.shape)
 
 
 @dataclass
@@ -205,67 +250,120 @@ class _Match:
     value: float
 
 
-def _row_matches(gray: np.ndarray, y: int, cfg: DetectorConfig, x_limit: int) -> list[_Match]:
-    """Sharp local maxima above ``c_min`` of ``m_y`` on scanline ``y`` with ``x <
-    x_limit`` (§3.1), with the §3.3 peak scan every ``peak_step`` pixels."""
-    w, l, d = cfg.window, cfg.peak_step, cfg.delta
-    nx = gray.shape[1] - w + 1
+@njit(cache=True)
+def _row_peaks(row, step, min_peak, delta, x_limit, w, xi, a, wa0, wa1, b, wb0, wb1):
+    """The sharp peaks of ``m_y`` on one scanline (§3.1, §3.3): positions (sub-pixel,
+    float64) and values. ``m_y`` is evaluated at every ``step``-th column, then densely
+    within ``step`` of every sample above ``min_peak / 4``; a peak is a sample at least
+    its left and above its right neighbour (unevaluated: -inf), above ``min_peak`` and
+    left of ``x_limit``, whose values ``delta`` either side (evaluated when needed) are
+    below half its own."""
+    taps = (w, xi, a, wa0, wa1, b, wb0, wb1)
+    nx = row.size - w + 1
+    xs_out = np.empty(0, np.float64)
+    vs_out = np.empty(0, np.float32)
     if nx <= 2:
-        return []
-    values = np.full(nx, np.nan, np.float32)
-    coarse = match_function(gray[y:y + 1], cfg.p, w, l)[0]
-    values[::l] = coarse
-    if l > 1:
-        hits = np.flatnonzero(coarse >= cfg.min_peak / 4) * l
-        if hits.size == 0:
-            return []
-        todo = np.unique((hits[:, None] + np.arange(-l, l + 1)[None, :]).ravel())
-        todo = todo[(todo >= 0) & (todo < nx) & np.isnan(values[np.clip(todo, 0, nx - 1)])]
-        values[todo] = match_points(gray, np.full(todo.shape, y), todo, cfg.p, w)
-    v = np.where(np.isnan(values), -np.inf, values)
-    centre = v[1:-1]
-    peaks = np.flatnonzero((centre >= v[:-2]) & (centre > v[2:])
-                           & (centre > cfg.min_peak)) + 1
-    peaks = peaks[peaks < x_limit]
-    if peaks.size == 0:
-        return []
-    sides = np.concatenate([peaks - d, peaks + d])
-    around = np.full(sides.shape, -np.inf, np.float32)
-    inside = (sides >= 0) & (sides < nx)
-    known = np.zeros(sides.shape, bool)
-    known[inside] = ~np.isnan(values[sides[inside]])
-    around[known] = values[sides[known]]
-    need = inside & ~known
-    around[need] = match_points(gray, np.full(int(need.sum()), y), sides[need], cfg.p, w)
-    left, right = around[:peaks.size], around[peaks.size:]
-    out = []
-    for x, lv, rv in zip(peaks, left, right):
-        value = float(v[x])
-        if lv < value / 2 and rv < value / 2:
-            # sub-pixel position from a parabola through the peak and its neighbours
-            a, b, c = v[x - 1], v[x], v[x + 1]
-            denom = a - 2 * b + c
-            offset = 0.5 * (a - c) / denom if np.isfinite(denom) and denom < 0 else 0.0
-            out.append(_Match(-1, y, float(x + np.clip(offset, -0.5, 0.5)), value))
-    return out
+        return xs_out, vs_out
+    values = np.full(nx, np.float32(np.nan))
+    n = (nx + step - 1) // step
+    coarse = _m_strided(row, n, step, *taps)
+    for i in range(n):
+        values[i * step] = coarse[i]
+    if step > 1:
+        low = min_peak / np.float32(4.0)
+        todo = np.zeros(nx, np.bool_)
+        hit = False
+        for i in range(n):
+            if coarse[i] >= low:
+                hit = True
+                for x in range(max(0, i * step - step), min(nx, i * step + step + 1)):
+                    todo[x] = True
+        if not hit:
+            return xs_out, vs_out
+        for x in range(nx):
+            if todo[x] and np.isnan(values[x]):
+                values[x] = _m_at(row, x, *taps)
+    v = values.copy()
+    for x in range(nx):
+        if np.isnan(v[x]):
+            v[x] = -np.inf
+    xs_list, vs_list = [], []
+    for x in range(1, min(nx - 1, x_limit)):
+        value = v[x]
+        if not (value >= v[x - 1] and value > v[x + 1] and value > min_peak):
+            continue
+        sharp = True
+        for side in (x - delta, x + delta):
+            around = -np.inf
+            if 0 <= side < nx:
+                around = values[side]
+                if np.isnan(around):
+                    around = _m_at(row, side, *taps)
+            if not (around < np.float64(value) / 2.0):
+                sharp = False
+        if not sharp:
+            continue
+        # sub-pixel position from a parabola through the peak and its neighbours
+        denom = v[x - 1] - np.float32(2.0) * value + v[x + 1]
+        offset = np.float32(0.0)
+        if np.isfinite(denom) and denom < 0:
+            offset = np.float32(0.5) * (v[x - 1] - v[x + 1]) / denom
+            offset = min(max(offset, np.float32(-0.5)), np.float32(0.5))
+        xs_list.append(np.float64(x) + np.float64(offset))
+        vs_list.append(value)
+    if len(xs_list):
+        xs_out = np.array(xs_list)
+        vs_out = np.array(vs_list)
+    return xs_out, vs_out
+
+
+@njit(cache=True)
+def _rows_peaks(gray, ys, step, min_peak, delta, x_limit, w, xi, a, wa0, wa1, b, wb0, wb1):
+    """:func:`_row_peaks` on scanlines ``ys`` of ``gray``: ``(index into ys, x, value)``
+    of every peak, in one compiled call."""
+    rows, xs, vs = [], [], []
+    for r in range(ys.size):
+        px, pv = _row_peaks(gray[ys[r]], step, min_peak, delta, x_limit, w, xi, a, wa0, wa1,
+                            b, wb0, wb1)
+        for j in range(px.size):
+            rows.append(r)
+            xs.append(px[j])
+            vs.append(pv[j])
+    return np.array(rows, np.int64), np.array(xs, np.float64), np.array(vs, np.float32)
+
+
+def _row_matches(gray: np.ndarray, ys: list[int], cfg: DetectorConfig,
+                 x_limit: int) -> list[list[_Match]]:
+    """For each scanline ``y`` of ``ys``: the sharp local maxima above ``c_min`` of ``m_y``
+    with ``x < x_limit`` (§3.1), with the §3.3 peak scan every ``peak_step`` pixels."""
+    found: list[list[_Match]] = [[] for _ in ys]
+    if not ys:
+        return found
+    rows, xs, vs = _rows_peaks(gray, np.asarray(ys, np.int64), cfg.peak_step,
+                               np.float32(cfg.min_peak), cfg.delta, int(x_limit), cfg.window,
+                               *_taps(cfg.p, cfg.window))
+    for r, x, v in zip(rows.tolist(), xs.tolist(), vs.tolist()):
+        found[r].append(_Match(-1, ys[r], x, v))
+    return found
 
 
 def _scan(gray: np.ndarray, cfg: DetectorConfig, x_limit: int) -> list[list[_Match]]:
     """Matches per scanline ``k/2, k/2 + k, ...``; with ``coarse_rows`` every second
     scanline first and the others only next to a scanline that matched (§3.3)."""
     ys = list(range(cfg.row_step // 2, gray.shape[0], cfg.row_step))
-    found: list[list[_Match] | None] = [None] * len(ys)
-    first = range(0, len(ys), 2) if cfg.coarse_rows else range(len(ys))
-    for i in first:
-        found[i] = _row_matches(gray, ys[i], cfg, x_limit)
+    found: list[list[_Match]] = [[] for _ in ys]
+    first = list(range(0, len(ys), 2) if cfg.coarse_rows else range(len(ys)))
+    for i, row in zip(first, _row_matches(gray, [ys[i] for i in first], cfg, x_limit)):
+        found[i] = row
     if cfg.coarse_rows:
-        for i in range(1, len(ys), 2):
-            if found[i - 1] or (i + 1 < len(ys) and found[i + 1]):
-                found[i] = _row_matches(gray, ys[i], cfg, x_limit)
+        second = [i for i in range(1, len(ys), 2)
+                  if found[i - 1] or (i + 1 < len(ys) and found[i + 1])]
+        for i, row in zip(second, _row_matches(gray, [ys[i] for i in second], cfg, x_limit)):
+            found[i] = row
     for i, row in enumerate(found):
-        for m in row or ():
+        for m in row:
             m.row = i
-    return [row or [] for row in found]
+    return found
 
 
 def _chains(rows: list[list[_Match]], cfg: DetectorConfig) -> list[list[_Match]]:
@@ -303,24 +401,46 @@ def _interp(gray: np.ndarray, y: int, xs: np.ndarray) -> np.ndarray:
     return np.interp(xs, np.arange(gray.shape[1]), gray[y]).astype(np.float32)
 
 
-def _extent(gray: np.ndarray, chain: list[_Match], a: float, b: float,
+def _columns(gray: np.ndarray, xs: np.ndarray, y0: int, y1: int) -> np.ndarray:
+    """Rows ``y0 .. y1-1`` of ``gray`` at fractional columns ``xs`` inside the image,
+    ``(y1 - y0, len(xs))`` float32: :func:`_interp` of every row at once (the same
+    float64 arithmetic as ``np.interp``: ``(right - left) * t + left``)."""
+    i = np.floor(xs).astype(np.int64)
+    left = gray[y0:y1, i].astype(np.float64)
+    right = gray[y0:y1, i + 1].astype(np.float64)
+    return ((right - left) * (xs - i) + left).astype(np.float32)
+
+
+@njit(cache=True)
+def _walk(gray, y, direction, limit, a, b, level, w, xi, ta, wa0, wa1, tb, wb0, wb1):
+    """The last row reached from row ``y`` moving by ``direction`` (at most ``limit``
+    rows) while ``m_y`` on the line ``x = a y + b`` (best of the three nearest columns)
+    stays at or above ``level``."""
+    for _ in range(limit):
+        nxt = y + direction
+        if not (0 <= nxt < gray.shape[0]):
+            break
+        x = int(np.rint(a * nxt + b))
+        best = np.float32(-1.0)
+        for c in range(x - 1, x + 2):
+            if c >= 0 and c + w <= gray.shape[1]:
+                best = max(best, _m_at(gray[nxt], c, w, xi, ta, wa0, wa1, tb, wb0, wb1))
+        if not (np.float64(best) >= level):
+            break
+        y = nxt
+    return y
+
+
+def _extent(gray: np.ndarray, chain: list[_Match], a: float, b: float, strength: float,
             cfg: DetectorConfig) -> tuple[float, float]:
-    """Rows of the pattern's top and bottom edges along the line ``x = a y + b``."""
-    level = 0.5 * float(np.median([m.value for m in chain]))
-
-    def passes(y: int) -> bool:
-        x = int(round(a * y + b))
-        return float(np.max(match_points(gray, [y] * 3, [x - 1, x, x + 1], cfg.p,
-                                         cfg.window))) >= level
-
+    """Rows of the pattern's top and bottom edges along the line ``x = a y + b``: walked
+    from the outermost matches while ``m_y`` stays above half the chain's median peak
+    ``strength``; each edge lies halfway between the last row that passes and the next."""
+    taps = _taps(cfg.p, cfg.window)
     edges = []
     for start, direction in ((chain[0].y, -1), (chain[-1].y, 1)):
-        y = start
-        for _ in range(2 * cfg.row_step):
-            nxt = y + direction
-            if not (0 <= nxt < gray.shape[0]) or not passes(nxt):
-                break
-            y = nxt
+        y = _walk(gray, start, direction, 2 * cfg.row_step, float(a), float(b),
+                  0.5 * strength, cfg.window, *taps)
         edges.append(y + 0.5 * direction)
     return edges[0], edges[1]
 
@@ -371,29 +491,33 @@ def _barcode(gray: np.ndarray, x_bar: float, half: float, top: float, bottom: fl
     y0, y1 = max(0, int(math.floor(top - 0.5 * h))), min(gray.shape[0], int(math.ceil(bottom + 0.5 * h)))
     if y1 - y0 < BARCODE_BANDS or not (0 <= x_bar - half and x_bar + half < gray.shape[1] - 1):
         return None
-    xs = x_bar + np.linspace(-half, half, 3)
-    column = np.array([_interp(gray, y, xs).mean() for y in range(y0, y1)])
+    xs = x_bar + np.array([-half, 0.0, half])
+    column = _columns(gray, xs, y0, y1).mean(axis=1)
     dark = np.flatnonzero(column < thr)
     if dark.size == 0:
         return None
-    start, end = y0 + dark[0] - 0.5, y0 + dark[-1] + 0.5
+    start, end = y0 + int(dark[0]) - 0.5, y0 + int(dark[-1]) + 0.5
     band = (end - start) / BARCODE_BANDS
     if band < 1.0 or not (0.5 < (end - start) / h < 2.0):
         return None
-    bands = []
+    # each band's mean over its central half: rows [lo, hi) (sums by np.add.reduceat over
+    # the bounds lo_0, hi_0, lo_1, ...; every other sum is a band's)
+    bounds = []
     for i in range(BARCODE_BANDS):
         lo = int(round(start + (i + 0.25) * band + 0.5))
-        hi = max(lo + 1, int(round(start + (i + 0.75) * band + 0.5)))
-        bands.append(int(column[lo - y0:hi - y0].mean() < thr))
-    return decode_barcode(bands)
+        bounds += [lo - y0, max(lo + 1, int(round(start + (i + 0.75) * band + 0.5))) - y0]
+    bounds = np.array(bounds)
+    sums = np.add.reduceat(np.append(column, np.float32(0)), bounds)[::2]
+    means = sums / (bounds[1::2] - bounds[::2]).astype(np.float32)
+    return decode_barcode([int(m < thr) for m in means])
 
 
 def detect_landmarks(image: np.ndarray, model: CameraModel,
                      config: DetectorConfig = DetectorConfig()) -> list[Detection]:
     """Every self-similar landmark in ``image`` (uint8 RGB/grey, or float grey in [0, 1])
     seen through ``model``, strongest first; at most one detection per id."""
-    gray = to_gray(image) if np.asarray(image).dtype == np.uint8 else np.asarray(
-        image, dtype=np.float32)
+    gray = np.ascontiguousarray(to_gray(image) if np.asarray(image).dtype == np.uint8
+                                else np.asarray(image, dtype=np.float32))
     width = gray.shape[1]
     if model.wraps:  # a panorama: continue each row past its end so patterns may wrap
         gray = np.concatenate([gray, gray[:, :width // 2]], axis=1)
@@ -403,12 +527,13 @@ def detect_landmarks(image: np.ndarray, model: CameraModel,
         ys = np.array([m.y for m in chain], dtype=np.float64)
         xs = np.array([m.x for m in chain], dtype=np.float64)
         a, b = np.polyfit(ys, xs, 1)
-        top, bottom = _extent(gray, chain, a, b, cfg)
+        strength = statistics.median([m.value for m in chain])
+        top, bottom = _extent(gray, chain, a, b, strength, cfg)
         y_mid = int(round((top + bottom) / 2 - 0.5))
         x0 = a * y_mid + b
         profile = _interp(gray, y_mid, x0 + np.arange(0, gray.shape[1] - x0 - 1))
         head = profile[:cfg.window]
-        lo, hi = float(np.percentile(head, 5)), float(np.percentile(head, 95))
+        lo, hi = (float(v) for v in np.percentile(head, [5, 95]))
         sigma = _pattern_width(profile, lo, hi, cfg)
         lay = cfg.layout
         landmark_id = None
@@ -426,7 +551,7 @@ def detect_landmarks(image: np.ndarray, model: CameraModel,
             centre_x=float(centre % width if model.wraps else centre),
             bearing=wrap_angle(float(model.bearing(centre))),
             distance=model.distance(x0, top, bottom, lay.pattern_height),
-            strength=float(np.median([m.value for m in chain])), matches=len(chain)))
+            strength=strength, matches=len(chain)))
     found.sort(key=lambda d: -d.strength * d.matches)
     unique: list[Detection] = []
     for det in found:

@@ -8,7 +8,7 @@ import pytest
 
 from homing_baselines.camera_models import PanoramaModel, PerspectiveModel
 from homing_baselines.selfsimilar_detector import (DetectorConfig, detect_landmarks,
-                                            match_function)
+                                                   match_function, match_points)
 from homing_gym.selfsimilar import (BARCODE_BANDS, MAX_ID, PanelLayout, barcode_bits,
                                     decode_barcode, panel_image, self_similar)
 
@@ -46,6 +46,30 @@ def test_match_function_peaks_at_the_origin(origin, sigma):
     # half contrast halves the response (§3: c s_p gives c)
     half = match_function(_scanline(origin, sigma, contrast=0.5)[None], 2 / 3, 45)[0]
     assert half.max() == pytest.approx(m.max() / 2, rel=0.1)
+
+
+def _eq7(row, x, p, w):
+    """Eq. 7 written out directly (float64, np.interp for the in-between pixels)."""
+    xi = np.arange(w)
+    grid = np.arange(row.size)
+    base = row[x + xi]
+    anti = np.interp(x + math.sqrt(p) * xi, grid, row)
+    similar = np.interp(x + p * xi, grid, row)
+    return (np.abs(base - anti).sum() - np.abs(base - similar).sum()) / w
+
+
+@pytest.mark.parametrize("w,step", [(45, 1), (22, 3), (45, 5)])
+def test_compiled_match_function_and_points_agree_with_eq7(w, step):
+    rows = np.random.default_rng(2).random((3, 160)).astype(np.float32)
+    m = match_function(rows, 2 / 3, w, step)
+    xs = np.arange(0, 160 - w + 1, step)
+    assert m.shape == (3, xs.size)
+    expected = [[_eq7(r.astype(np.float64), x, 2 / 3, w) for x in xs] for r in rows]
+    np.testing.assert_allclose(m, expected, atol=2e-6)
+    ys, cols = np.meshgrid(np.arange(3), xs, indexing="ij")
+    assert np.array_equal(match_points(rows, ys, cols * 1, 2 / 3, w), m)
+    # outside the image: -1
+    assert match_points(rows, [0, 5, 0], [-1, 0, 160 - w + 1], 2 / 3, w).tolist() == [-1] * 3
 
 
 def test_match_function_is_low_on_other_patterns():
