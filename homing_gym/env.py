@@ -32,6 +32,9 @@ from homing_gym.topdown import compose_frame, draw_topdown
 from homing_gym.validation import require_positive
 
 ACTION_TYPES = ("continuous", "discrete")
+#: Where ``odometry`` starts: zero in the start pose's frame (path integration from where
+#: the robot was put), or the start pose in home's frame (a privileged homing vector).
+ODOMETRY_ORIGINS = ("start", "home")
 #: Bounds of the simulation settings: physics sub-steps per control period, the control
 #: period (seconds) and the physics step (seconds; longer steps let the robot pass
 #: through walls, shorter ones only cost time).
@@ -61,8 +64,8 @@ class HomingEnv(gym.Env):
                  action_type: str = "continuous", control_period: float = 0.1,
                  physics_substeps: int = 24, max_speed: float = RobotConfig.max_speed,
                  max_yaw_rate: float = RobotConfig.max_yaw_rate, stop_threshold: float = 0.05,
-                 odometry_noise: float = 0.02, lighting_change: float = 0.0,
-                 goal_step_length: float = 0.15,
+                 odometry_noise: float = 0.02, odometry_origin: str = "start",
+                 lighting_change: float = 0.0, goal_step_length: float = 0.15,
                  camera_height: float = RobotConfig.camera_height,
                  sky_color: tuple[float, float, float] | None = None):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -73,6 +76,9 @@ class HomingEnv(gym.Env):
                              f"here: {why}; use render_mode='rgb_array' (frames as arrays)")
         if action_type not in ACTION_TYPES:
             raise ValueError(f"unknown action_type {action_type!r}; allowed: {ACTION_TYPES}")
+        if odometry_origin not in ODOMETRY_ORIGINS:
+            raise ValueError(f"unknown odometry_origin {odometry_origin!r}; allowed: "
+                             f"{ODOMETRY_ORIGINS}")
         if not (isinstance(physics_substeps, (int, np.integer))
                 and 1 <= physics_substeps <= MAX_SUBSTEPS):
             raise ValueError(f"physics_substeps must be an integer in [1, {MAX_SUBSTEPS}], "
@@ -128,6 +134,7 @@ class HomingEnv(gym.Env):
             panorama_shape=tuple(panorama_shape), vfov=math.radians(vfov_deg),
             n_views=n_views, omni_size=omni_size, renderer=renderer)
         self.odometry = WheelOdometry(self.robot_config, odometry_noise)
+        self.odometry_origin = odometry_origin
         self._scene_factory = scene_factory(scene)
         self.scene = self._scene_factory.build(np.random.default_rng(0))
         task.check_scene(self.scene)
@@ -227,11 +234,12 @@ class HomingEnv(gym.Env):
         return self.camera.render(self.sim.client, pose)
 
     def _place_robot(self, pose, clear_contacts: bool = False) -> None:
-        """Teleport the robot to ``pose`` and restart odometry there, in home's frame."""
+        """Teleport the robot to ``pose`` and restart odometry there: at zero
+        (``odometry_origin="start"``) or at the pose in home's frame (``"home"``)."""
         self.sim.place_robot(pose, clear_contacts)
         self.pose = self.sim.robot.pose()
-        self.odometry.reset(to_frame(self.episode.home, self.pose),
-                            self.sim.robot.wheel_angles())
+        origin = self.episode.home if self.odometry_origin == "home" else self.pose
+        self.odometry.reset(to_frame(origin, self.pose), self.sim.robot.wheel_angles())
 
     def _goal_sight(self, pose: np.ndarray) -> Sight:
         """The snapshot of a goal: its panorama is taken now, with the robot standing at

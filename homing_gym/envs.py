@@ -51,14 +51,18 @@ class LocalHomingEnv(HomingEnv):
     | `goal_step` | same | panorama taken `goal_step_length` (0.15 m) straight ahead of home: a second nest snapshot (Yu & Kim §II-A) |
     | `omni`, `goal_omni` | `Box(0, 255, (S, S, 3), uint8)` | catadioptric ring images, default S = 128 |
     | `signature`, `goal_signature` | `Box(0, 1, (W,), float32)` | Hong 1991 horizon signatures |
-    | `odometry` | `Box(-inf, inf, (3,), float32)` | wheel-encoder path integration: pose (x, y, yaw) in the home frame |
+    | `odometry` | `Box(-inf, inf, (3,), float32)` | wheel-encoder path integration: pose (x, y, yaw) in the start pose's frame (``odometry_origin``) |
 
     Panorama convention: column ``x`` in ``[0, W)`` has bearing ``pi - 2*pi*x/W`` (radians,
     counter-clockwise from the heading): straight ahead at the centre column, directly
     behind at the edges, the horizon at row ``H/2``. See :mod:`homing_gym.panorama`.
-    ``odometry`` starts at the true start pose relative to home (as if the robot had driven
-    out from home) and then integrates the wheel encoders, each increment scaled by
-    ``1 + N(0, odometry_noise)``.
+    ``odometry`` starts at zero in the start pose's frame (``odometry_origin="start"``,
+    the default: path integration from where the robot was put, which says nothing about
+    home) and then integrates the wheel encoders, each increment scaled by
+    ``1 + N(0, odometry_noise)``. ``odometry_origin="home"`` starts it at the true start
+    pose in home's frame instead, as if the robot had driven out from home: the exact
+    homing vector at reset, so a method given it is not homing from vision alone and its
+    results must say so.
 
     ## Rewards
 
@@ -104,7 +108,8 @@ class LocalHomingEnv(HomingEnv):
     :mod:`homing_gym.raycast`), ``omni_size`` = 128,
     ``action_type``, ``control_period`` (at most 2 s), ``physics_substeps`` (1-1000; each
     physics step between 1/2000 and 1/60 s), ``max_speed``,
-    ``max_yaw_rate``, ``stop_threshold``, ``odometry_noise`` = 0.02, ``goal_step_length`` = 0.15,
+    ``max_yaw_rate``, ``stop_threshold``, ``odometry_noise`` = 0.02,
+    ``odometry_origin`` = ``"start"`` (or ``"home"``), ``goal_step_length`` = 0.15,
     ``lighting_change`` = 0
     (0-1: strength of an illumination change between the home snapshot and the run, drawn
     from the seed: light direction, brightness, contrast),
@@ -150,7 +155,8 @@ class RouteFollowingEnv(HomingEnv):
 
     As ``LocalHoming-v0`` (``obs_keys``): ``panorama``, ``goal`` (the current target's
     snapshot), optional ``omni``, ``goal_omni``, ``signature``, ``goal_signature``,
-    ``odometry`` (pose in the frame of the last target).
+    ``odometry`` (zero at the start; with ``odometry_origin="home"`` the pose in the
+    frame of the last target).
 
     ## Rewards
 
@@ -235,7 +241,8 @@ class LongRangeHomingEnv(HomingEnv):
     | `phase` | `Discrete(2)` | 0 outbound (the env drives), 1 homing (the agent drives) |
 
     ``goal`` is the home snapshot throughout. ``odometry`` (if asked for) integrates the
-    wheel encoders from home, over the outbound route too.
+    wheel encoders from home, where the episode starts, over the outbound route too
+    (both origins are home here).
 
     ## Rewards
 

@@ -43,7 +43,7 @@ BAD_KWARGS = [
     {"scene": "nowhere"}, {"scene": 5}, {"reward": {"nope": 1}},
     {"reward": {"progress": "x"}}, {"reward": {"progress": NAN}}, {"stop_threshold": 2},
     {"vfov_deg": 500}, {"renderer": "nope"}, {"omni_size": 3},
-    {"max_episode_steps": 0}, {"max_episode_steps": 2.5},
+    {"max_episode_steps": 0}, {"max_episode_steps": 2.5}, {"odometry_origin": "goal"},
 ]
 BAD_COMMANDS = [   # (module of the command, arguments)
     ("homing_train.harness.evaluate", ["--policy", "nope", "--out", "{tmp}/r.json"]),

@@ -70,18 +70,37 @@ def test_collision_with_landmark(make_env):
     assert poses[:, 0].max() < 0.45 - 0.1075 - 0.16 + 0.01
 
 
-def test_odometry_without_noise_tracks_true_pose(make_env):
+@pytest.mark.parametrize("origin", ["start", "home"])
+def test_odometry_without_noise_tracks_true_pose(make_env, origin):
     env = make_env(obs_keys=("panorama", "goal", "odometry"), odometry_noise=0.0,
-                   panorama_shape=(16, 64), start_distance=(0.3, 0.4))
+                   panorama_shape=(16, 64), start_distance=(0.3, 0.4), odometry_origin=origin)
     obs, info = env.reset(seed=2)
-    assert np.allclose(obs["odometry"], to_frame(info["goal_pose"], info["pose"]), atol=1e-5)
+    frame = info["start_pose"] if origin == "start" else info["goal_pose"]
+    assert np.allclose(obs["odometry"], to_frame(frame, info["pose"]), atol=1e-5)
     for action, steps in (((1.0, 0.0), 3), ((0.0, 1.0), 10), ((0.5, -0.5), 5), ((-0.5, 0.0), 3)):
         for _ in range(steps):
             obs, _, _, _, info = env.step(np.array(action, np.float32))
     assert info["collisions"] == 0
-    truth = to_frame(info["goal_pose"], info["pose"])
+    truth = to_frame(frame, info["pose"])
     assert np.hypot(*(obs["odometry"][:2] - truth[:2])) < 0.03
     assert abs(wrap_angle(obs["odometry"][2] - truth[2])) < 0.05
+
+
+def test_default_odometry_at_reset_is_zero_whatever_home_is(make_env):
+    env = make_env(obs_keys=("panorama", "odometry"), panorama_shape=(16, 64))
+    start = (-0.5, -0.4, 0.3)
+    seen = []
+    for home in ((0.6, 0.5, 0.0), (-0.9, 0.8, 2.0)):
+        obs, info = env.reset(seed=4, options={"start": start, "home": home})
+        assert np.allclose(info["home_pose"][:2], home[:2])
+        seen.append(obs["odometry"])
+    assert np.array_equal(seen[0], seen[1]) and np.allclose(seen[0], 0.0)
+    privileged = make_env(obs_keys=("panorama", "odometry"), panorama_shape=(16, 64),
+                          odometry_origin="home")
+    obs, info = privileged.reset(seed=4, options={"start": start, "home": (0.6, 0.5, 0.0)})
+    assert np.allclose(obs["odometry"], to_frame(info["home_pose"], info["pose"]), atol=1e-5)
+    with pytest.raises(ValueError, match="odometry_origin 'goal'"):
+        make_env(odometry_origin="goal")
 
 
 def test_odometry_noise_makes_estimates_drift(make_env):
