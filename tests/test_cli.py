@@ -7,7 +7,7 @@ import pytest
 from homing_gym.cli import plain
 
 COMMANDS = {
-    "homing-eval": "homing_train.harness.evaluate",
+    "homing-eval": "homing_train.harness.eval_command",
     "homing-compare": "homing_train.harness.compare",
     "homing-field": "homing_train.harness.field",
     "homing-suite": "homing_train.harness.suite",
@@ -56,7 +56,7 @@ def test_import_makes_a_user_scene_visible_to_the_command_and_its_workers(tmp_pa
         "bounds=((-1.5, -1.5), (1.5, 1.5)), walls=square_walls(3.0), "
         "landmarks=(Landmark((0.5, 0.5), radius=0.05, height=1.0),))))\n")
     env = {**os.environ, "PYTHONPATH": str(tmp_path)}
-    command = [sys.executable, "-m", "homing_train.harness.evaluate", "--policy", "oracle",
+    command = [sys.executable, "-m", "homing_train.harness.eval_command", "--policy", "oracle",
                "--episodes", "2", "--workers", "2", "--quiet", "--env-kwargs",
                '{"scene": "two_poles", "max_episode_steps": 5}', "--out",
                str(tmp_path / "r.json")]

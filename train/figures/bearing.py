@@ -322,26 +322,15 @@ def fig11(out: str, runs: int = 30, max_steps: int = 800, seed: int = 11,
           progress: bool = True) -> dict[str, dict[str, float]]:
     """Fig. 11 from pixels: the unified law ``runs`` times to each marked position from
     seeded random collision-free starts 0.5-3 m away; writes ``fig11.json``."""
-    from homing_gym.scenes.base import clearance
+    from homing_train.harness.protocols import marked_goal_starts
 
     env = lab_env(max_steps)
-    scene = env.unwrapped.scene
-    rng = np.random.default_rng(seed)
-    (xmin, ymin), (xmax, ymax) = scene.bounds
-    results: dict[str, list[dict]] = {}
-    bar = tqdm(total=runs * len(scene.metadata["marked"]), desc="Fig. 11 runs",
-               disable=not progress)
-    for goal, point in scene.metadata["marked"].items():
-        results[goal] = []
-        while len(results[goal]) < runs:
-            xy = (float(rng.uniform(xmin, xmax)), float(rng.uniform(ymin, ymax)))
-            if clearance(scene, xy) < 0.3 or not 0.5 <= np.hypot(xy[0] - point[0],
-                                                                  xy[1] - point[1]) <= 3.0:
-                continue
-            start = (*xy, float(rng.uniform(-np.pi, np.pi)))
-            results[goal].append(lab_run(env, "unified", start, goal))
-            bar.update()
-    bar.close()
+    marked = list(env.unwrapped.scene.metadata["marked"])
+    tasks = marked_goal_starts("lab", runs, seed, GOAL_YAW)
+    results: dict[str, list[dict]] = {goal: [] for goal in marked}
+    for i, (_, start, _) in enumerate(tqdm(tasks, desc="Fig. 11 runs", disable=not progress)):
+        goal = marked[i // runs]
+        results[goal].append(lab_run(env, "unified", start, goal))
     env.close()
     summary = {}
     for goal, rs in results.items():

@@ -56,6 +56,7 @@ from homing_gym.geometry import wrap_angle  # noqa: E402
 from homing_gym.scenes.base import clearance  # noqa: E402
 from homing_gym.topdown import HOME, MapCanvas, draw_pose, draw_scene  # noqa: E402
 from homing_train.harness.metrics import wilson_interval  # noqa: E402
+from homing_train.harness.protocols import ring_starts  # noqa: E402
 
 ENV_ID = "homing_gym/LocalHoming-v0"
 HOME_POSE = (0.0, 0.0, 0.0)  # the nest: arena centre, among the four cylinders
@@ -297,25 +298,9 @@ def fig6_tasks(trials: int, seed: int, bins=FIG6_BINS) -> list[list[tuple]]:
     """Per bin, ``trials`` tasks (seed, start, home): the nest fixed at ``HOME_POSE`` (as
     the paper's nest), starts at a distance uniform in the bin, uniform direction, random
     heading (§III: "an arbitrary position with random direction of heading"), with the
-    env's start clearance."""
-    env = gym.make(ENV_ID)
-    try:
-        env.reset(seed=0, options={"home": HOME_POSE})
-        scene = env.unwrapped.scene
-    finally:
-        env.close()
-    rng = np.random.default_rng(seed)
-    out = []
-    for b, (lo, hi) in enumerate(bins):
-        tasks = []
-        while len(tasks) < trials:
-            d, a = rng.uniform(lo, hi), rng.uniform(-np.pi, np.pi)
-            xy = (HOME_POSE[0] + d * math.cos(a), HOME_POSE[1] + d * math.sin(a))
-            if clearance(scene, xy) >= MARGIN:
-                start = (xy[0], xy[1], float(rng.uniform(-np.pi, np.pi)))
-                tasks.append((seed + 1000 * b + len(tasks), start, HOME_POSE))
-        out.append(tasks)
-    return out
+    env's start clearance (:func:`homing_train.harness.protocols.ring_starts`)."""
+    tasks = ring_starts("arena", HOME_POSE, bins, trials, seed, margin=MARGIN)
+    return [tasks[b * trials:(b + 1) * trials] for b in range(len(bins))]
 
 
 def run_success(out: str, trials: int, workers: int, seed: int, bins=FIG6_BINS,

@@ -4,10 +4,7 @@ Episode ``i`` of a suite with seed ``S`` is ``env.reset(seed=S + i)``, so every 
 the same scenes, homes and starts. Policies see only the observation; the harness alone
 reads ``info`` and the env's ground truth to compute the metrics of :mod:`homing_train.harness.metrics`.
 
-Command line (also ``python -m homing_train.harness.evaluate``)::
-
-    homing-eval --policy oracle --env homing_gym/LocalHoming-v0 --episodes 200 --seed 0 \
-        --workers 2 --out results/oracle.json
+The ``homing-eval`` command is :mod:`homing_train.harness.eval_command`.
 """
 
 from __future__ import annotations
@@ -20,7 +17,6 @@ import math
 import multiprocessing as mp
 import os
 import signal
-import sys
 import time
 from dataclasses import asdict, dataclass, field
 from typing import Any, Callable, Sequence
@@ -30,7 +26,6 @@ import numpy as np
 from tqdm import tqdm
 
 import homing_gym
-from homing_gym.cli import command_parser
 from homing_gym.paths import NoPathError, path_length, shortest_path
 from homing_gym.geometry import wrap_angle
 from homing_train.harness import metrics
@@ -81,7 +76,8 @@ class EvalResult:
 
     def __post_init__(self) -> None:
         if not self.summary:
-            self.summary = summarize(self.episodes, self.bin_width, seed=self.seed)
+            self.summary = summarize(self.episodes, self.bin_width, seed=self.seed,
+                                     radius=float(self.env_kwargs.get("success_radius", 0.15)))
 
     def to_dict(self) -> dict[str, Any]:
         return {"schema": SCHEMA, "policy": self.policy, "params": self.params,
@@ -142,9 +138,10 @@ def write_csv(episodes: Sequence[EpisodeRecord], path: str) -> None:
 
 
 def summarize(episodes: Sequence[EpisodeRecord], bin_width: float = 0.3,
-              seed: int = 0) -> dict[str, Any]:
+              seed: int = 0, radius: float = 0.15) -> dict[str, Any]:
     """Means with 95% CIs (success: Wilson; the others: seeded percentile bootstrap of the
-    mean) and success by start-distance bin."""
+    mean), success by start-distance bin, and ``reached_rate``: the share of episodes
+    that came within ``radius`` metres of the goal at any time (stopped there or not)."""
     if not episodes:
         raise ValueError("no episodes to summarize")
 
@@ -162,6 +159,9 @@ def summarize(episodes: Sequence[EpisodeRecord], bin_width: float = 0.3,
         ci_key = "success_ci" if key == "success_rate" else key.removesuffix("_mean") + "_ci"
         out[ci_key] = list(metrics.wilson_interval(int(values.sum()), values.size)
                            if key == "success_rate" else metrics.bootstrap_ci(values, seed=seed))
+    reached = int(np.sum(col("min_distance") <= radius))
+    out["reached_rate"] = reached / len(episodes)
+    out["reached_ci"] = list(metrics.wilson_interval(reached, len(episodes)))
     final_cm = 100 * col("final_distance")
     out["final_distance_cm_median"] = float(np.median(final_cm))
     out["heading_error_deg_median"] = float(np.median(col("final_heading_error_deg")))
@@ -295,14 +295,25 @@ def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int =
              env_kwargs: dict[str, Any] | None = None, workers: int = 1,
              params: dict[str, Any] | None = None, bin_width: float = 0.3,
              progress: bool = True, stream: str | None = None,
-             resume: bool = False) -> EvalResult:
+             resume: bool = False, tasks: Sequence[tuple] | None = None) -> EvalResult:
     """Evaluate ``policy`` (controller name, controller, :class:`PolicySpec` or SB3 zip
-    path) on episodes seeded ``seed .. seed + episodes - 1``.
+    path) on episodes seeded ``seed .. seed + episodes - 1``, or on ``tasks``
+    ``[(seed, start pose or None, home pose or None), ...]`` (distinct seeds; then
+    ``episodes`` and ``seed`` are taken from them).
 
     ``stream``: a JSON-lines file that gets each finished episode at once (its first line
     the settings), so an interrupted evaluation keeps what it finished; with ``resume``
     the episodes already in it are kept and only the others are run (same settings
     required), giving the records an uninterrupted run would give."""
+    if tasks is not None:
+        tasks = [tuple(t) + (None,) * (3 - len(t)) for t in tasks]
+        seeds = [t[0] for t in tasks]
+        if not tasks or len(set(seeds)) != len(seeds):
+            raise ValueError(f"tasks must be a non-empty list with distinct seeds, got seeds "
+                             f"{seeds[:10]}")
+        episodes, seed = len(tasks), seeds[0]
+    else:
+        seeds = list(range(seed, seed + episodes))
     if episodes < 1:
         raise ValueError(f"episodes must be >= 1, got {episodes}")
     if env_id not in gym.registry:
@@ -318,13 +329,14 @@ def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int =
         # what the controller reads; observation keys never change the episodes
         env_kwargs["obs_keys"] = list(spec.build().observation_keys())
     settings = json.loads(json.dumps({"policy": spec.label, "params": spec.resolved_params(),
-                                      "env_id": env_id, "env_kwargs": env_kwargs},
+                                      "env_id": env_id, "env_kwargs": env_kwargs,
+                                      **({"tasks": tasks} if tasks is not None else {})},
                                      default=_json_default))
     done = read_stream(stream, settings) if stream and resume else {}
-    tasks = [(s, None) for s in range(seed, seed + episodes) if s not in done]
+    todo = [t for t in (tasks or [(s, None, None) for s in seeds]) if t[0] not in done]
     sink = open_stream(stream, settings, append=bool(done)) if stream else None
     try:
-        fresh = run_episodes(spec, env_id, env_kwargs, tasks, workers, progress,
+        fresh = run_episodes(spec, env_id, env_kwargs, todo, workers, progress,
                              desc=f"{spec.label}",
                              on_record=None if sink is None else sink.write_record)
     finally:
@@ -333,7 +345,7 @@ def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int =
     records = {r.seed: r for r in fresh} | done
     return EvalResult(policy=spec.label, params=spec.resolved_params(), env_id=env_id,
                       env_kwargs=env_kwargs, seed=seed,
-                      episodes=[records[s] for s in range(seed, seed + episodes)],
+                      episodes=[records[s] for s in seeds],
                       bin_width=bin_width)
 
 
@@ -443,43 +455,3 @@ def format_summary(result: EvalResult) -> str:
             f"{s['final_distance_cm_median']:.1f}), heading error "
             f"{s['heading_error_deg_mean']:.1f} deg, collisions/episode "
             f"{s['collisions_mean']:.2f}")
-
-
-def main(argv: list[str] | None = None) -> int:
-    parser = command_parser("homing-eval", __doc__)
-    add_policy_arguments(parser)
-    parser.add_argument("--episodes", type=int, default=100)
-    parser.add_argument("--bin-width", type=float, default=0.3,
-                        help="start-distance bin width (m) for success by distance")
-    parser.add_argument("--out", required=True,
-                        help="result JSON path (a .csv goes beside; each finished episode is "
-                        "appended to NAME.episodes.jsonl as it ends)")
-    parser.add_argument("--resume", action="store_true",
-                        help="keep the episodes already in NAME.episodes.jsonl and run the rest")
-    args = parser.parse_args(argv)
-    try:
-        spec = policy_from_args(args)
-        for path in (args.out, stream_path(args.out)):
-            if os.path.isdir(path):
-                raise ValueError(f"--out {path!r} is a directory")
-        result = evaluate(spec, args.env, args.episodes, args.seed,
-                          parse_json_kwargs(args.env_kwargs), args.workers,
-                          bin_width=args.bin_width, progress=not args.quiet,
-                          stream=stream_path(args.out), resume=args.resume)
-    except ValueError as err:
-        parser.exit(2, f"homing-eval: error: {err}\n")
-    except KeyboardInterrupt:
-        parser.exit(130, f"homing-eval: interrupted; the finished episodes are in "
-                         f"{stream_path(args.out)}: the same command with --resume runs "
-                         f"the rest\n")
-    result.save(args.out)
-    if spec.kind == "sb3" and (recorded := recorded_settings(spec.source)).source:
-        print(f"settings recorded in {recorded.source} (explicit --env-kwargs/--param "
-              f"override them): env kwargs {result.env_kwargs}, params {result.params}")
-    print(format_summary(result))
-    print(f"wrote {args.out} and {os.path.splitext(args.out)[0]}.csv")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

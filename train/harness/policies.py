@@ -11,6 +11,8 @@ import dataclasses
 import json
 import os
 from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -218,3 +220,27 @@ class SB3Policy:
         mode = self.deterministic if deterministic is None else deterministic
         return self.model.predict(observation, state=state, episode_start=start,
                                   deterministic=mode)
+
+
+POLICY_DIR = Path(str(resources.files("homing_train") / "shipped"))
+
+
+@dataclass(frozen=True)
+class ShippedPolicy:
+    """A shipped model and how it is evaluated (from the ``.yml`` beside it)."""
+
+    path: Path
+    env_kwargs: dict
+    params: dict    # SB3 policy parameters, e.g. {"deterministic": False}
+    env_id: str | None = None   # the env it was trained on (None: any)
+
+
+def shipped_policies(folder: Path = POLICY_DIR) -> dict[str, ShippedPolicy]:
+    """Shipped PPO policies by name, with their recorded evaluation settings
+    (:func:`recorded_settings`)."""
+    found = {}
+    for model in sorted(folder.glob("*.zip")):
+        settings = recorded_settings(str(model))
+        found[model.stem] = ShippedPolicy(model, settings.env_kwargs, settings.params,
+                                          settings.env_id)
+    return found

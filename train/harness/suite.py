@@ -10,13 +10,19 @@ on the same seeded episodes (episode ``i`` uses seed ``seed + i``), writes one
 ``<method>.json``/``.csv`` per method into ``--out``, then runs ``homing-compare`` on them:
 ``table.md`` (printed), ``success_vs_distance.png``, ``final_distance.png`` and
 ``trajectories.png``.
+
+    homing-suite --protocols all --workers 2 --out results/matrix
+    homing-suite --protocols yukim bekris-lab --episodes 100
+
+runs every applicable method on each protocol (:mod:`homing_train.harness.protocols`,
+one success rule: stopped within the radius) and writes the methods x protocols matrix
+(:mod:`homing_train.harness.matrix`): ``matrix.md`` (printed; every cell with the
+``homing-eval --protocol`` command that reproduces it), ``.csv``, ``.json``, ``.png``.
 """
 
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass
-from importlib import resources
 from pathlib import Path
 
 import gymnasium as gym
@@ -26,31 +32,9 @@ from homing_gym.cli import command_parser
 from homing_train.extras import missing_extra
 from homing_train.harness.compare import compare
 from homing_train.harness.evaluate import DEFAULT_ENV, evaluate, format_summary
-from homing_train.harness.policies import recorded_settings
-
-POLICY_DIR = Path(str(resources.files("homing_train") / "shipped"))
-
-
-@dataclass(frozen=True)
-class ShippedPolicy:
-    """A shipped model and how it is evaluated (from the ``.yml`` beside it)."""
-
-    path: Path
-    env_kwargs: dict
-    params: dict    # SB3 policy parameters, e.g. {"deterministic": False}
-    env_id: str | None = None   # the env it was trained on (None: any)
-
-
-def shipped_policies(folder: Path = POLICY_DIR) -> dict[str, ShippedPolicy]:
-    """Shipped PPO policies by name, with their recorded evaluation settings
-    (:func:`homing_train.harness.policies.recorded_settings`)."""
-    found = {}
-    for model in sorted(folder.glob("*.zip")):
-        settings = recorded_settings(str(model))
-        found[model.stem] = ShippedPolicy(model, settings.env_kwargs, settings.params,
-                                          settings.env_id)
-    return found
-
+from homing_train.harness.matrix import matrix_markdown, run_matrix
+from homing_train.harness.policies import shipped_policies
+from homing_train.harness.protocols import PROTOCOLS, protocol
 
 def suite_methods(env_id: str) -> list[str]:
     """The registered controllers made for ``env_id`` in its default scene
@@ -94,15 +78,33 @@ def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: in
 
 def main(argv: list[str] | None = None) -> int:
     parser = command_parser("homing-suite", __doc__)
+    parser.add_argument("--protocols", nargs="+", metavar="NAME",
+                        help="run the methods x protocols matrix on these protocols ('all': "
+                        f"every one of {sorted(PROTOCOLS)}) instead of the one-env suite; "
+                        "--episodes then counts per setting (default: each protocol's)")
     parser.add_argument("--env", default=DEFAULT_ENV, help="env id of the suite")
-    parser.add_argument("--episodes", type=int, default=20, help="episodes per method")
+    parser.add_argument("--episodes", type=int, default=None,
+                        help="episodes per method (default 20; see --protocols)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the first episode")
     parser.add_argument("--workers", type=int, default=2, help="parallel processes")
     parser.add_argument("--methods", nargs="+", help="subset of methods (default: all)")
     parser.add_argument("--out", default="results", help="output folder (default: results)")
     args = parser.parse_args(argv)
-    if args.episodes < 1 or args.workers < 1:
+    if (args.episodes is not None and args.episodes < 1) or args.workers < 1:
         parser.error("--episodes and --workers must be >= 1")
+    if args.protocols:
+        try:
+            names = sorted(PROTOCOLS) if args.protocols == ["all"] else args.protocols
+            chosen = [protocol(name) for name in names]
+            cells = run_matrix(chosen, Path(args.out), args.episodes, args.workers,
+                               args.methods)
+        except ValueError as err:
+            parser.exit(2, f"homing-suite: error: {err}\n")
+        print(matrix_markdown(cells))
+        print(f"wrote {args.out}/matrix.md, matrix.csv, matrix.json, matrix.png")
+        return 0
+    if args.episodes is None:
+        args.episodes = 20
     try:
         written = run_suite(Path(args.out), args.env, args.episodes, args.seed, args.workers,
                             args.methods)

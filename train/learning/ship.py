@@ -22,7 +22,7 @@ from pathlib import Path
 import yaml
 
 from homing_gym.cli import command_parser
-from homing_train.harness.suite import POLICY_DIR
+from homing_train.harness.policies import POLICY_DIR
 
 MAX_BYTES = 10 * 2**20
 #: ``--model`` choices: the run folder's model files.

@@ -13,7 +13,7 @@ import pytest
 from homing_baselines import Controller
 from homing_baselines.motion import Move
 from homing_train.harness import compare as compare_cli
-from homing_train.harness import evaluate as eval_cli
+from homing_train.harness import eval_command as eval_cli
 from homing_train.harness import field as field_cli
 from homing_train.harness.evaluate import EvalResult, evaluate
 

@@ -10,7 +10,7 @@ import pytest
 import torch
 
 from homing_train.harness.policies import policy_spec
-from homing_train.harness.suite import POLICY_DIR
+from homing_train.harness.policies import POLICY_DIR
 from homing_train.learning.policy_zip import UntrustedPolicyError, load_policy
 
 SHIPPED = POLICY_DIR / "ppo_localhoming.zip"

@@ -3,7 +3,7 @@
 import pytest
 
 from homing_train.harness.evaluate import DEFAULT_ENV, evaluate
-from homing_train.harness.suite import shipped_policies
+from homing_train.harness.policies import shipped_policies
 
 SHIPPED = shipped_policies()
 

@@ -1,0 +1,120 @@
+"""Protocols and the methods x protocols matrix: episodes as the papers draw them, one
+success rule, cells that reproduce from their command."""
+
+import json
+import math
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import homing_gym  # noqa: F401
+from homing_gym.scenes.base import clearance
+from homing_train.harness import eval_command
+from homing_train.harness.evaluate import EpisodeRecord, summarize
+from homing_train.harness.matrix import (Cell, cell_methods, equal_time_kwargs, run_cell,
+                                         write_matrix)
+from homing_train.harness.protocols import (NEST, PROTOCOLS, marked_goal_starts, protocol,
+                                            ring_starts, scene_named)
+
+
+def test_every_protocol_makes_its_envs_with_the_stop_rule():
+    for p in PROTOCOLS.values():
+        assert p.methods and p.settings and p.version >= 1
+        for setting in p.settings:
+            assert setting.kwargs()["success_on"] == "stop"
+            env = gym.make(setting.env_id, **setting.kwargs())
+            env.close()
+    with pytest.raises(ValueError, match="unknown protocol 'nope'"):
+        protocol("nope")
+
+
+def test_yukim_starts_lie_in_the_fig6_bins_around_the_nest():
+    bins = ((0.3, 0.6), (0.6, 0.9), (0.9, 1.2), (1.2, 1.4))
+    tasks = ring_starts("arena", NEST, bins, 5, seed=3)
+    assert len(tasks) == 20 and len({t[0] for t in tasks}) == 20
+    arena = scene_named("arena")
+    for i, (seed, start, home) in enumerate(tasks):
+        lo, hi = bins[i // 5]
+        assert lo <= math.dist(start[:2], NEST[:2]) < hi
+        assert clearance(arena, start[:2]) >= 0.22 and home == NEST
+    assert ring_starts("arena", NEST, bins, 5, seed=3) == tasks          # seeded
+
+
+def test_bekris_starts_are_half_to_three_metres_from_each_marked_goal():
+    lab = scene_named("lab")
+    marked = list(lab.metadata["marked"].values())
+    tasks = marked_goal_starts("lab", 2, seed=11, goal_yaw=0.5)
+    assert len(tasks) == 2 * len(marked)
+    for i, (_, start, home) in enumerate(tasks):
+        goal = marked[i // 2]
+        assert np.allclose(home, (goal[0], goal[1], 0.5))
+        assert 0.5 <= math.dist(start[:2], goal[:2]) <= 3.0
+
+
+def test_a_policy_with_a_longer_control_period_gets_the_same_time():
+    recorded = {"control_period": 0.2, "max_episode_steps": 250, "panorama_shape": [32, 128]}
+    merged = equal_time_kwargs({"scene": "arena", "max_episode_steps": 300,
+                                "success_on": "stop"}, recorded)
+    assert merged["max_episode_steps"] == 150 and merged["panorama_shape"] == [32, 128]
+    assert merged["scene"] == "arena" and merged["success_on"] == "stop"
+    assert equal_time_kwargs({"scene": "lab"}, recorded)["max_episode_steps"] == 250
+
+
+def test_policies_expand_to_the_shipped_policies_of_the_protocols_env():
+    methods = cell_methods(protocol("local-common"))
+    assert "policies" not in methods and "oracle" in methods
+    assert "ppo_localhoming" in methods
+    assert "ppo_localhoming" not in cell_methods(protocol("briggs-corridors"))
+
+
+def test_reached_counts_episodes_that_came_within_the_radius_at_any_time():
+    def record(seed, success, min_distance):
+        return EpisodeRecord(seed=seed, start_pose=[0, 0, 0], home_pose=[1, 0, 0],
+                             start_distance=1.0, shortest_path=1.0, success=success,
+                             terminated=success, truncated=not success, steps=10,
+                             path_length=1.0, final_distance=0.5, min_distance=min_distance,
+                             collisions=0, spl=0.0, soft_spl=0.0, final_heading_error_deg=0.0,
+                             wall_time=0.1)
+    s = summarize([record(0, True, 0.1), record(1, False, 0.12), record(2, False, 0.3),
+                   record(3, False, 0.2)], radius=0.15)
+    assert s["success_rate"] == 0.25 and s["reached_rate"] == 0.5
+
+
+def test_oracle_cell_on_yukim_stops_at_the_nest_and_its_command_reproduces_it(tmp_path):
+    cell = run_cell(protocol("yukim"), "oracle", tmp_path / "a", episodes=4, progress=False)
+    assert cell.summary["episodes"] == 4                   # one start per Fig. 6 bin
+    assert cell.summary["success_rate"] == 1.0             # stopped within 0.15 m each time
+    assert cell.command == "homing-eval --protocol yukim --policy oracle --episodes 4 --out OUT.json"
+    out = tmp_path / "b.json"
+    assert eval_command.main(["--protocol", "yukim", "--policy", "oracle", "--episodes", "4",
+                              "--quiet", "--out", str(out)]) == 0
+    again = json.loads(out.read_text())
+    assert again["summary"]["episodes"] == 4
+    assert [s["success_rate"] for s in again["settings"].values()] == [1.0]
+    assert again["summary"]["final_distance_mean"] == pytest.approx(
+        cell.summary["final_distance_mean"])
+
+
+def test_protocol_mode_refuses_settings_the_protocol_fixes(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exit_:
+        eval_command.main(["--protocol", "yukim", "--policy", "oracle", "--env-kwargs",
+                           '{"scene": "lab"}', "--out", str(tmp_path / "x.json")])
+    assert exit_.value.code == 2 and "--protocol fixes" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        eval_command.main(["--protocol", "yukim", "--policy", "selfsimilar_nope",
+                           "--out", str(tmp_path / "x.json")])
+
+
+def test_matrix_files_name_every_cell_with_its_command(tmp_path):
+    summary = {"episodes": 10, "success_rate": 0.3, "success_ci": [0.1, 0.6],
+               "reached_rate": 0.5, "reached_ci": [0.2, 0.8], "spl": 0.25,
+               "final_distance_mean": 0.42}
+    cells = [Cell("yukim", 1, m, f"homing-eval --protocol yukim --policy {m} --out OUT.json",
+                  summary, {}) for m in ("warping", "distance")]
+    written = write_matrix(cells, tmp_path)
+    text = open(written["md"]).read()
+    assert "| warping | 30 [10, 60] |" in text
+    assert "`homing-eval --protocol yukim --policy distance --out OUT.json`" in text
+    assert open(written["csv"]).read().count("\n") == 3
+    assert open(written["png"], "rb").read(4) == b"\x89PNG"

@@ -1,0 +1,218 @@
+"""Running protocols (:mod:`homing_train.harness.protocols`): one method on one protocol
+(a *cell*), and the methods x protocols matrix.
+
+A cell runs the method on every setting of the protocol with :func:`evaluate` (episodes
+streamed to ``<setting>.episodes.jsonl``, so an interrupted run resumes), writes each
+setting's result JSON and ``cell.json`` (the summary over all its episodes, per-setting
+success and the command that reproduces it). The matrix writes ``matrix.md``,
+``matrix.csv``, ``matrix.json`` and ``matrix.png`` (a heat map of success).
+
+Shipped policies are run with the settings recorded beside them (their panorama size,
+action type, control period); where a protocol caps the episode length
+(``max_episode_steps``, counted in steps of the default 0.1 s control period) a policy with
+another control period gets the same time, not the same number of steps.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import re
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Sequence
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+import homing_baselines  # noqa: E402
+from homing_train.extras import missing_extra  # noqa: E402
+from homing_train.harness.evaluate import EpisodeRecord, evaluate, summarize  # noqa: E402
+from homing_train.harness.policies import shipped_policies  # noqa: E402
+from homing_train.harness.protocols import POLICIES, Protocol  # noqa: E402
+
+#: The control period (s) that protocols count ``max_episode_steps`` in.
+BASE_PERIOD = 0.1
+
+
+@dataclass
+class Cell:
+    """One method on one protocol: the summary over all its episodes (success under
+    the stop rule, ``reached_rate``, SPL, ... with 95% CIs), per-setting success and
+    episode counts, and the command that reproduces it."""
+
+    protocol: str
+    version: int
+    method: str
+    command: str
+    summary: dict
+    settings: dict
+    privileged: str = ""
+
+
+def shipped_for(env_ids: Sequence[str]) -> dict:
+    """Shipped PPO policies trained on one of ``env_ids`` (none without the train extra)."""
+    if missing_extra("train"):
+        return {}
+    return {name: p for name, p in shipped_policies().items() if p.env_id in env_ids}
+
+
+def cell_methods(protocol: Protocol) -> list[str]:
+    """The protocol's methods, ``policies`` replaced by the shipped policies trained on
+    its envs."""
+    names: list[str] = []
+    for method in protocol.methods:
+        if method == POLICIES:
+            names += sorted(shipped_for({s.env_id for s in protocol.settings}))
+        else:
+            names.append(method)
+    return names
+
+
+def equal_time_kwargs(setting_kwargs: dict, recorded: dict) -> dict:
+    """A shipped policy's recorded env kwargs under a setting's: the setting wins, except
+    that a step cap counted at :data:`BASE_PERIOD` becomes the same time at the policy's
+    control period."""
+    merged = {**recorded, **setting_kwargs}
+    period = float(recorded.get("control_period", BASE_PERIOD))
+    if "max_episode_steps" in setting_kwargs and period != BASE_PERIOD:
+        merged["max_episode_steps"] = max(1, round(setting_kwargs["max_episode_steps"]
+                                                   * BASE_PERIOD / period))
+    return merged
+
+
+def _slug(text: str) -> str:
+    return re.sub(r"[^a-z0-9]+", "_", text.lower()).strip("_")
+
+
+def run_cell(protocol: Protocol, method: str, out: Path, episodes: int | None = None,
+             workers: int = 1, progress: bool = True, resume: bool = False) -> Cell:
+    """Run ``method`` (a controller name or a shipped policy's) on every setting of
+    ``protocol`` (``episodes`` per setting, default the protocol's) into ``out``."""
+    n = protocol.episodes if episodes is None else episodes
+    if n < 1:
+        raise ValueError(f"episodes must be >= 1, got {n}")
+    shipped = shipped_for({s.env_id for s in protocol.settings})
+    if method not in shipped and method not in homing_baselines.available():
+        raise ValueError(f"unknown method {method!r} for protocol {protocol.name!r}; "
+                         f"allowed: {cell_methods(protocol)}")
+    out.mkdir(parents=True, exist_ok=True)
+    records: list[EpisodeRecord] = []
+    per_setting = {}
+    for setting in protocol.settings:
+        kwargs = setting.kwargs()
+        if method in shipped:
+            policy, params = str(shipped[method].path), shipped[method].params
+            kwargs = equal_time_kwargs(kwargs, shipped[method].env_kwargs)
+        else:
+            policy, params = method, {}
+        stem = out / _slug(setting.label)
+        result = evaluate(policy, setting.env_id, env_kwargs=kwargs, workers=workers,
+                          params=params, progress=progress,
+                          stream=f"{stem}.episodes.jsonl", resume=resume,
+                          tasks=setting.episode_tasks(n, protocol.seed))
+        result.save(f"{stem}.json")
+        records += result.episodes
+        per_setting[setting.label] = {
+            "episodes": len(result.episodes), "success_rate": result.summary["success_rate"],
+            "reached_rate": result.summary["reached_rate"]}
+    radius = protocol.success_radius(protocol.settings[0])
+    cell = Cell(protocol=protocol.name, version=protocol.version, method=method,
+                command=protocol.command(method, episodes),
+                summary=summarize(records, radius=radius), settings=per_setting,
+                privileged=protocol.privileged)
+    (out / "cell.json").write_text(json.dumps(asdict(cell), indent=1))
+    return cell
+
+
+def run_matrix(protocols: Sequence[Protocol], out: Path, episodes: int | None = None,
+               workers: int = 1, methods: Sequence[str] | None = None,
+               progress: bool = True, resume: bool = False) -> list[Cell]:
+    """Every applicable method (or those of ``methods`` that apply) on every protocol;
+    cells under ``out/<protocol>/<method>/``, the matrix files in ``out``."""
+    cells = []
+    for protocol in protocols:
+        for method in cell_methods(protocol):
+            if methods and method not in methods:
+                continue
+            cells.append(run_cell(protocol, method, out / protocol.name / method, episodes,
+                                  workers, progress, resume))
+    write_matrix(cells, out)
+    return cells
+
+
+def _pct(summary: dict, key: str, ci: str) -> str:
+    lo, hi = summary[ci]
+    return f"{100 * summary[key]:.0f} [{100 * lo:.0f}, {100 * hi:.0f}]"
+
+
+def matrix_markdown(cells: Sequence[Cell]) -> str:
+    """Success % [95% Wilson CI] by method and protocol, then one row per cell with
+    the other metrics and the command that reproduces it."""
+    protocols = list(dict.fromkeys(c.protocol for c in cells))
+    methods = list(dict.fromkeys(c.method for c in cells))
+    by = {(c.protocol, c.method): c for c in cells}
+    lines = ["Success: the agent stopped within the success radius (0.15 m) of the goal; "
+             "% with 95% Wilson interval, episodes per cell in the second table.", "",
+             "| method | " + " | ".join(protocols) + " |",
+             "|---|" + "---:|" * len(protocols)]
+    for m in methods:
+        row = [(_pct(by[(p, m)].summary, "success_rate", "success_ci") if (p, m) in by
+                else "") for p in protocols]
+        lines.append(f"| {m} | " + " | ".join(row) + " |")
+    lines += ["", "| protocol | method | episodes | success % [95% CI] | reached % [95% CI] "
+              "| SPL | final distance (cm) | command |", "|---|---|---:|---:|---:|---:|---:|---|"]
+    for c in cells:
+        s = c.summary
+        lines.append(f"| {c.protocol} v{c.version} | {c.method} | {s['episodes']} | "
+                     f"{_pct(s, 'success_rate', 'success_ci')} | "
+                     f"{_pct(s, 'reached_rate', 'reached_ci')} | {s['spl']:.2f} | "
+                     f"{100 * s['final_distance_mean']:.0f} | `{c.command}` |")
+    return "\n".join(lines) + "\n"
+
+
+def plot_matrix(cells: Sequence[Cell], path: str) -> None:
+    """Heat map of success % (methods x protocols) with k/n in each cell."""
+    protocols = list(dict.fromkeys(c.protocol for c in cells))
+    methods = list(dict.fromkeys(c.method for c in cells))
+    grid = np.full((len(methods), len(protocols)), np.nan)
+    fig, ax = plt.subplots(figsize=(1.6 + 1.3 * len(protocols), 0.9 + 0.45 * len(methods)),
+                           dpi=110)
+    for c in cells:
+        i, j = methods.index(c.method), protocols.index(c.protocol)
+        grid[i, j] = 100 * c.summary["success_rate"]
+        k = round(c.summary["success_rate"] * c.summary["episodes"])
+        ax.text(j, i, f"{grid[i, j]:.0f}%\n{k}/{c.summary['episodes']}", ha="center",
+                va="center", fontsize=7, color="black" if grid[i, j] > 45 else "white")
+    image = ax.imshow(grid, cmap="viridis", vmin=0, vmax=100, aspect="auto")
+    ax.set_xticks(range(len(protocols)), protocols, rotation=30, ha="right", fontsize=8)
+    ax.set_yticks(range(len(methods)), methods, fontsize=8)
+    ax.set_title("success % (stopped within 0.15 m); k/n episodes; blank: not applicable",
+                 fontsize=8)
+    fig.colorbar(image, ax=ax, label="success %")
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def write_matrix(cells: Sequence[Cell], out: Path) -> dict[str, str]:
+    """``matrix.md``, ``.csv``, ``.json`` and ``.png`` in ``out``."""
+    out.mkdir(parents=True, exist_ok=True)
+    written = {kind: str(out / f"matrix.{kind}") for kind in ("md", "csv", "json", "png")}
+    Path(written["md"]).write_text(matrix_markdown(cells))
+    Path(written["json"]).write_text(json.dumps([asdict(c) for c in cells], indent=1))
+    keys = ("episodes", "success_rate", "success_ci", "reached_rate", "reached_ci", "spl",
+            "final_distance_mean")
+    with open(written["csv"], "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(["protocol", "version", "method", *keys, "command"])
+        for c in cells:
+            writer.writerow([c.protocol, c.version, c.method,
+                             *(json.dumps(c.summary[k]) if isinstance(c.summary[k], list)
+                               else c.summary[k] for k in keys), c.command])
+    if cells:
+        plot_matrix(cells, written["png"])
+    return written
