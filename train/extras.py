@@ -5,7 +5,7 @@ from __future__ import annotations
 import importlib.util
 
 #: The modules each extra of ``pyproject.toml`` provides, as far as the code imports them.
-EXTRAS = {"train": ("stable_baselines3", "torch"), "video": ("moviepy",)}
+EXTRAS = {"train": ("stable_baselines3", "torch"), "video": ("moviepy",), "ray": ("ray",)}
 
 
 class MissingExtraError(ImportError):

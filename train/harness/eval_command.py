@@ -19,7 +19,8 @@ import sys
 from pathlib import Path
 
 from homing_gym.cli import command_parser
-from homing_train.harness.evaluate import (DEFAULT_ENV, add_policy_arguments, evaluate,
+from homing_train.harness.evaluate import (DEFAULT_ENV, add_backend_arguments,
+                                           add_policy_arguments, evaluate,
                                            format_summary, parse_json_kwargs, policy_from_args,
                                            stream_path)
 from homing_train.harness.matrix import run_cell
@@ -35,7 +36,8 @@ def _protocol_cell(args) -> int:
     chosen = protocol(args.protocol)
     folder = Path(os.path.splitext(args.out)[0])
     cell = run_cell(chosen, args.policy, folder, args.episodes, args.workers,
-                    progress=not args.quiet, resume=args.resume)
+                    progress=not args.quiet, resume=args.resume, backend=args.backend,
+                    address=args.ray_address)
     Path(args.out).write_text((folder / "cell.json").read_text())
     s = cell.summary
     print(f"{args.policy} on {chosen.label}: {s['episodes']} episodes, success (stopped "
@@ -62,6 +64,7 @@ def main(argv: list[str] | None = None) -> int:
                         "appended to NAME.episodes.jsonl as it ends)")
     parser.add_argument("--resume", action="store_true",
                         help="keep the episodes already in NAME.episodes.jsonl and run the rest")
+    add_backend_arguments(parser)
     args = parser.parse_args(argv)
     try:
         for path in (args.out, stream_path(args.out)):
@@ -73,7 +76,8 @@ def main(argv: list[str] | None = None) -> int:
         result = evaluate(spec, args.env, 100 if args.episodes is None else args.episodes,
                           args.seed, parse_json_kwargs(args.env_kwargs), args.workers,
                           bin_width=args.bin_width, progress=not args.quiet,
-                          stream=stream_path(args.out), resume=args.resume)
+                          stream=stream_path(args.out), resume=args.resume,
+                          backend=args.backend, address=args.ray_address)
     except ValueError as err:
         parser.exit(2, f"homing-eval: error: {err}\n")
     except KeyboardInterrupt:

@@ -28,6 +28,7 @@ from tqdm import tqdm
 import homing_gym
 from homing_gym.paths import NoPathError, path_length, shortest_path
 from homing_gym.geometry import wrap_angle
+from homing_train.extras import require_extra
 from homing_train.harness import metrics
 from homing_train.harness.policies import (PolicySpec, parse_params, policy_spec,
                                            recorded_settings)
@@ -243,23 +244,72 @@ def _work(task: tuple) -> EpisodeRecord:
     return run_episode(_WORKER["env"], _WORKER["policy"], *task)
 
 
+class _EpisodeActor:
+    """A Ray actor holding one env and policy (``backend="ray"``)."""
+
+    def __init__(self, spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any]):
+        _init_worker(spec, env_id, env_kwargs)
+
+    def run(self, item: tuple[int, tuple]) -> tuple[int, EpisodeRecord]:
+        return _indexed_work(item)
+
+
+def _ray_records(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
+                 tasks: Sequence[tuple], workers: int, address: str | None):
+    """``(index, record)`` of every task as Ray actors finish them: ``workers`` actors on
+    the cluster at ``address`` (``"auto"``: the running one), or on a local Ray started
+    with ``workers`` CPUs. A worker's error is raised as itself."""
+    require_extra("ray", "backend='ray'")
+    import ray
+    from ray.util import ActorPool
+
+    if not ray.is_initialized():
+        user_modules = {k: v for k, v in os.environ.items() if k == "HOMING_GYM_IMPORT"}
+        local = {} if address else {"num_cpus": workers, "object_store_memory": 200 * 2**20,
+                                    "include_dashboard": False}
+        ray.init(address=address, log_to_driver=False, logging_level="ERROR",
+                 runtime_env={"env_vars": user_modules} if user_modules else None, **local)
+    actor = ray.remote(num_cpus=1)(_EpisodeActor)
+    pool = ActorPool([actor.remote(spec, env_id, env_kwargs)
+                      for _ in range(min(workers, len(tasks)))])
+    try:
+        yield from pool.map_unordered(lambda a, item: a.run.remote(item),
+                                      list(enumerate(tasks)))
+    except ray.exceptions.RayTaskError as err:
+        raise err.cause from None
+
+
+BACKENDS = ("local", "ray")
+
+
 def run_episodes(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
                  tasks: Sequence[tuple], workers: int = 1,
                  progress: bool = True, desc: str = "episodes",
-                 on_record: Callable[[EpisodeRecord], None] | None = None
+                 on_record: Callable[[EpisodeRecord], None] | None = None,
+                 backend: str = "local", address: str | None = None
                  ) -> list[EpisodeRecord]:
     """Run ``tasks`` = [(seed, start pose or None[, home pose or None]), ...] over
-    ``workers`` processes (spawn context; 1 = in this process). Records come back in task
-    order; ``on_record`` sees each one as soon as it is finished (in finishing order)."""
+    ``workers`` processes (``backend="local"``: spawned processes, 1 = in this process;
+    ``"ray"``: Ray actors, on the cluster at ``address`` or a local Ray). Records come
+    back in task order, the same on either backend; ``on_record`` sees each one as soon
+    as it is finished (in finishing order)."""
     for task in tasks:
         if not 1 <= len(task) <= 3:
             raise ValueError(f"a task is (seed, start, home), got {task!r}")
     if workers < 1:
         raise ValueError(f"workers must be >= 1, got {workers}")
+    if backend not in BACKENDS:
+        raise ValueError(f"unknown backend {backend!r}; allowed: {BACKENDS}")
     bar = tqdm(total=len(tasks), desc=desc, disable=not progress, unit="ep")
     records: list[EpisodeRecord | None] = [None] * len(tasks)
     try:
-        if workers == 1 or len(tasks) <= 1:
+        if backend == "ray":
+            for i, record in _ray_records(spec, env_id, env_kwargs, tasks, workers, address):
+                records[i] = record
+                if on_record is not None:
+                    on_record(record)
+                bar.update()
+        elif workers == 1 or len(tasks) <= 1:
             _init_worker(spec, env_id, env_kwargs)
             try:
                 for i, task in enumerate(tasks):
@@ -295,7 +345,8 @@ def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int =
              env_kwargs: dict[str, Any] | None = None, workers: int = 1,
              params: dict[str, Any] | None = None, bin_width: float = 0.3,
              progress: bool = True, stream: str | None = None,
-             resume: bool = False, tasks: Sequence[tuple] | None = None) -> EvalResult:
+             resume: bool = False, tasks: Sequence[tuple] | None = None,
+             backend: str = "local", address: str | None = None) -> EvalResult:
     """Evaluate ``policy`` (controller name, controller, :class:`PolicySpec` or SB3 zip
     path) on episodes seeded ``seed .. seed + episodes - 1``, or on ``tasks``
     ``[(seed, start pose or None, home pose or None), ...]`` (distinct seeds; then
@@ -304,7 +355,8 @@ def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int =
     ``stream``: a JSON-lines file that gets each finished episode at once (its first line
     the settings), so an interrupted evaluation keeps what it finished; with ``resume``
     the episodes already in it are kept and only the others are run (same settings
-    required), giving the records an uninterrupted run would give."""
+    required), giving the records an uninterrupted run would give. ``backend``/``address``:
+    see :func:`run_episodes`."""
     if tasks is not None:
         tasks = [tuple(t) + (None,) * (3 - len(t)) for t in tasks]
         seeds = [t[0] for t in tasks]
@@ -338,7 +390,8 @@ def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int =
     try:
         fresh = run_episodes(spec, env_id, env_kwargs, todo, workers, progress,
                              desc=f"{spec.label}",
-                             on_record=None if sink is None else sink.write_record)
+                             on_record=None if sink is None else sink.write_record,
+                             backend=backend, address=address)
     finally:
         if sink is not None:
             sink.close()
@@ -434,6 +487,16 @@ def add_policy_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--trust-policy", action="store_true",
                         help="load a model zip with pickle: RUNS CODE FROM THE FILE (only for "
                         "files you trust; by default zips are read without unpickling)")
+
+
+def add_backend_arguments(parser: argparse.ArgumentParser) -> None:
+    """The ``--backend/--ray-address`` options."""
+    parser.add_argument("--backend", choices=BACKENDS, default="local",
+                        help="where episodes run: local processes (--workers of them) or Ray "
+                        "actors (--workers of them; needs the [ray] extra)")
+    parser.add_argument("--ray-address", default=None, metavar="ADDRESS",
+                        help="with --backend ray: the cluster to join ('auto': the running "
+                        "one; default: start a local Ray)")
 
 
 def policy_from_args(args: argparse.Namespace) -> PolicySpec:

@@ -89,9 +89,11 @@ def _slug(text: str) -> str:
 
 
 def run_cell(protocol: Protocol, method: str, out: Path, episodes: int | None = None,
-             workers: int = 1, progress: bool = True, resume: bool = False) -> Cell:
+             workers: int = 1, progress: bool = True, resume: bool = False,
+             backend: str = "local", address: str | None = None) -> Cell:
     """Run ``method`` (a controller name or a shipped policy's) on every setting of
-    ``protocol`` (``episodes`` per setting, default the protocol's) into ``out``."""
+    ``protocol`` (``episodes`` per setting, default the protocol's) into ``out``
+    (``backend``/``address``: :func:`homing_train.harness.evaluate.run_episodes`)."""
     n = protocol.episodes if episodes is None else episodes
     if n < 1:
         raise ValueError(f"episodes must be >= 1, got {n}")
@@ -113,7 +115,8 @@ def run_cell(protocol: Protocol, method: str, out: Path, episodes: int | None = 
         result = evaluate(policy, setting.env_id, env_kwargs=kwargs, workers=workers,
                           params=params, progress=progress,
                           stream=f"{stem}.episodes.jsonl", resume=resume,
-                          tasks=setting.episode_tasks(n, protocol.seed))
+                          tasks=setting.episode_tasks(n, protocol.seed), backend=backend,
+                          address=address)
         result.save(f"{stem}.json")
         records += result.episodes
         per_setting[setting.label] = {
@@ -130,7 +133,8 @@ def run_cell(protocol: Protocol, method: str, out: Path, episodes: int | None = 
 
 def run_matrix(protocols: Sequence[Protocol], out: Path, episodes: int | None = None,
                workers: int = 1, methods: Sequence[str] | None = None,
-               progress: bool = True, resume: bool = False) -> list[Cell]:
+               progress: bool = True, resume: bool = False, backend: str = "local",
+               address: str | None = None) -> list[Cell]:
     """Every applicable method (or those of ``methods`` that apply) on every protocol;
     cells under ``out/<protocol>/<method>/``, the matrix files in ``out``."""
     cells = []
@@ -139,7 +143,7 @@ def run_matrix(protocols: Sequence[Protocol], out: Path, episodes: int | None = 
             if methods and method not in methods:
                 continue
             cells.append(run_cell(protocol, method, out / protocol.name / method, episodes,
-                                  workers, progress, resume))
+                                  workers, progress, resume, backend, address))
     write_matrix(cells, out)
     return cells
 

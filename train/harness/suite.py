@@ -31,7 +31,8 @@ import homing_gym  # noqa: F401  (registers the env ids)
 from homing_gym.cli import command_parser
 from homing_train.extras import missing_extra
 from homing_train.harness.compare import compare
-from homing_train.harness.evaluate import DEFAULT_ENV, evaluate, format_summary
+from homing_train.harness.evaluate import (DEFAULT_ENV, add_backend_arguments, evaluate,
+                                           format_summary)
 from homing_train.harness.matrix import matrix_markdown, run_matrix
 from homing_train.harness.policies import shipped_policies
 from homing_train.harness.protocols import PROTOCOLS, protocol
@@ -48,7 +49,8 @@ def suite_methods(env_id: str) -> list[str]:
 
 
 def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: int = 0,
-              workers: int = 2, methods: list[str] | None = None) -> dict[str, str]:
+              workers: int = 2, methods: list[str] | None = None, backend: str = "local",
+              address: str | None = None) -> dict[str, str]:
     """Evaluate the methods (default: all controllers and shipped policies) and compare."""
     out.mkdir(parents=True, exist_ok=True)
     policies = {name: p for name, p in shipped_policies().items()
@@ -68,7 +70,7 @@ def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: in
         policy, kwargs, params = (str(shipped.path), shipped.env_kwargs, shipped.params) \
             if shipped else (name, {}, {})
         result = evaluate(policy, env_id, episodes=episodes, seed=seed, env_kwargs=kwargs,
-                          workers=workers, params=params)
+                          workers=workers, params=params, backend=backend, address=address)
         print(format_summary(result))
         path = out / f"{name}.json"
         result.save(str(path))
@@ -89,6 +91,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--workers", type=int, default=2, help="parallel processes")
     parser.add_argument("--methods", nargs="+", help="subset of methods (default: all)")
     parser.add_argument("--out", default="results", help="output folder (default: results)")
+    add_backend_arguments(parser)
     args = parser.parse_args(argv)
     if (args.episodes is not None and args.episodes < 1) or args.workers < 1:
         parser.error("--episodes and --workers must be >= 1")
@@ -97,7 +100,7 @@ def main(argv: list[str] | None = None) -> int:
             names = sorted(PROTOCOLS) if args.protocols == ["all"] else args.protocols
             chosen = [protocol(name) for name in names]
             cells = run_matrix(chosen, Path(args.out), args.episodes, args.workers,
-                               args.methods)
+                               args.methods, backend=args.backend, address=args.ray_address)
         except ValueError as err:
             parser.exit(2, f"homing-suite: error: {err}\n")
         print(matrix_markdown(cells))
@@ -107,7 +110,7 @@ def main(argv: list[str] | None = None) -> int:
         args.episodes = 20
     try:
         written = run_suite(Path(args.out), args.env, args.episodes, args.seed, args.workers,
-                            args.methods)
+                            args.methods, args.backend, args.ray_address)
     except ValueError as err:
         parser.exit(2, f"homing-suite: error: {err}\n")
     print(Path(written["table"]).read_text())

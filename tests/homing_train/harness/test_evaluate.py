@@ -236,3 +236,28 @@ def test_homing_eval_refuses_an_unwritable_out_before_running(tmp_path, capsys):
                        "--out", str(blocker / "sub" / "r.json")])
     assert exit_.value.code == 2
     assert "cannot write" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_ray_backend_gives_the_records_of_the_local_pool():
+    pytest.importorskip("ray")
+    import dataclasses
+
+    import ray
+
+    from homing_train.harness.evaluate import evaluate
+
+    kwargs = {"panorama_shape": [16, 64], "max_episode_steps": 40}
+    try:
+        runs = [evaluate("random", episodes=3, seed=5, env_kwargs=kwargs, workers=2,
+                         progress=False, backend=backend) for backend in ("local", "ray")]
+        with pytest.raises(ValueError, match="unknown scene 'nowhere'"):
+            evaluate("random", episodes=2, env_kwargs={"scene": "nowhere"}, workers=2,
+                     progress=False, backend="ray")
+    finally:
+        ray.shutdown()
+
+    def strip(r):
+        return [{k: v for k, v in dataclasses.asdict(e).items() if k != "wall_time"}
+                for e in r.episodes]
+    assert strip(runs[0]) == strip(runs[1]) and len(runs[1].episodes) == 3
