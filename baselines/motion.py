@@ -9,6 +9,10 @@ that executes it open loop, for both action types of the env, in one of two styl
 * ``"pursuit"``: a smooth circular arc through the target point (turn and drive at once;
   turns on the spot first only when the target is more than 45 degrees off the heading).
 
+On a synchro-drive robot (``drive="synchro"``: it translates without turning, as Hong et
+al.'s did) either style translates straight along the direction, and a move of length
+0 does nothing (the body cannot turn).
+
 Moves are executed open loop; on the simulated robot a turn overshoots by a few degrees
 (inertia), so controllers should decide again after short steps.
 
@@ -57,6 +61,7 @@ class MotionSpec:
     max_yaw_rate: float = 1.5
     control_period: float = 0.1
     stop_threshold: float = 0.05
+    drive: str = "differential"
 
     @classmethod
     def from_env(cls, env) -> "MotionSpec":
@@ -64,7 +69,8 @@ class MotionSpec:
         u = env.unwrapped
         return cls(action_type=u.action_type, max_speed=u.robot_config.max_speed,
                    max_yaw_rate=u.robot_config.max_yaw_rate,
-                   control_period=u.control_period, stop_threshold=u.stop_threshold)
+                   control_period=u.control_period, stop_threshold=u.stop_threshold,
+                   drive=u.robot_config.drive)
 
     @property
     def step_turn(self) -> float:
@@ -91,6 +97,8 @@ class MotionHelper:
             raise ValueError(f"unknown motion style {style!r}; allowed: {MOTION_STYLES}")
         if spec.action_type not in ("continuous", "discrete"):
             raise ValueError(f"unknown action_type {spec.action_type!r}")
+        if spec.drive == "synchro" and spec.action_type != "continuous":
+            raise ValueError("a synchro drive takes continuous actions")
         self.spec = spec
         self.style = style
         self.pursuit_gain = float(pursuit_gain)
@@ -104,10 +112,26 @@ class MotionHelper:
     def plan(self, move: Move) -> list:
         """Actions that carry out ``move``; empty if the move is below one command's
         resolution (it would otherwise read as a stop)."""
+        if self.spec.drive == "synchro":
+            return self._translate(move)
         if self.style == "pursuit" and self.spec.action_type == "continuous" \
                 and move.distance > 0:
             return self._pursuit(move)
         return self._turn(wrap_angle(move.direction)) + self._drive(move.distance)
+
+    def _translate(self, move: Move) -> list:
+        """Synchro drive: straight along ``move.direction`` at constant speed, the
+        normalised action being the body-frame velocity."""
+        s = self.spec
+        n = math.ceil(move.distance / s.step_distance - 1e-9)
+        if n == 0:
+            return []
+        speed = move.distance / (n * s.step_distance)
+        action = np.array([speed * math.cos(move.direction), speed * math.sin(move.direction)],
+                          np.float32)
+        if np.max(np.abs(action)) < s.stop_threshold:
+            return []
+        return [action.copy() for _ in range(n)]
 
     # -- turn then drive -----------------------------------------------------------------
     def _turn(self, angle: float) -> list:

@@ -21,7 +21,7 @@ from homing_gym.geometry import to_frame
 from homing_gym.observations import CORE_KEYS, ObservationKey, Sight, goal_step_key
 from homing_gym.panorama import CameraConfig, Lighting, PanoramaCamera, random_lighting
 from homing_gym.perspective import PerspectiveConfig, render_perspective
-from homing_gym.robot import RobotConfig, WheelOdometry
+from homing_gym.robot import RobotConfig, odometry_for
 from homing_gym.scenes import scene_factory
 from homing_gym.scenes.base import Scene
 from homing_gym.simulator import Simulator, gui_unavailable
@@ -66,7 +66,7 @@ class HomingEnv(gym.Env):
                  max_yaw_rate: float = RobotConfig.max_yaw_rate, stop_threshold: float = 0.05,
                  odometry_noise: float = 0.02, odometry_origin: str = "start",
                  lighting_change: float = 0.0, goal_step_length: float = 0.15,
-                 camera_height: float = RobotConfig.camera_height,
+                 camera_height: float = RobotConfig.camera_height, drive: str = "differential",
                  sky_color: tuple[float, float, float] | None = None):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"unknown render_mode {render_mode!r}; allowed: "
@@ -127,13 +127,19 @@ class HomingEnv(gym.Env):
                     isinstance(c, (int, float)) and 0 <= c <= 1 for c in sky_color):
                 raise ValueError(f"sky_color must be three RGB values in [0, 1], "
                                  f"got {sky_color!r}")
+        if drive == "synchro" and action_type != "continuous":
+            raise ValueError("drive='synchro' takes continuous actions (vx, vy); got "
+                             f"action_type={action_type!r}")
+        if drive == "synchro" and task.drives_robot:
+            raise ValueError(f"drive='synchro' is not available in {type(task).__name__}: "
+                             f"the task drives the robot itself (unicycle commands)")
         self.robot_config = RobotConfig(max_speed=float(max_speed),
                                         max_yaw_rate=float(max_yaw_rate),
-                                        camera_height=float(camera_height))
+                                        camera_height=float(camera_height), drive=drive)
         camera_config = CameraConfig(
             panorama_shape=tuple(panorama_shape), vfov=math.radians(vfov_deg),
             n_views=n_views, omni_size=omni_size, renderer=renderer)
-        self.odometry = WheelOdometry(self.robot_config, odometry_noise)
+        self.odometry = odometry_for(self.robot_config, odometry_noise)
         self.odometry_origin = odometry_origin
         self._scene_factory = scene_factory(scene)
         self.scene = self._scene_factory.build(np.random.default_rng(0))
@@ -239,7 +245,7 @@ class HomingEnv(gym.Env):
         self.sim.place_robot(pose, clear_contacts)
         self.pose = self.sim.robot.pose()
         origin = self.episode.home if self.odometry_origin == "home" else self.pose
-        self.odometry.reset(to_frame(origin, self.pose), self.sim.robot.wheel_angles())
+        self.odometry.reset(to_frame(origin, self.pose), self.sim.robot.encoders())
 
     def _goal_sight(self, pose: np.ndarray) -> Sight:
         """The snapshot of a goal: its panorama is taken now, with the robot standing at
@@ -364,11 +370,15 @@ class HomingEnv(gym.Env):
             raise RuntimeError("call reset() before step()")
         v, w, stopped = self.task.command(self._task_context, *self._command(action))
         robot = self.sim.robot
-        robot.drive(v * self.robot_config.max_speed, w * self.robot_config.max_yaw_rate)
+        if robot.synchro:     # (v, w) read as the body-frame velocity, speed at most max_speed
+            scale = self.robot_config.max_speed / max(1.0, math.hypot(v, w))
+            robot.drive_planar(v * scale, w * scale)
+        else:
+            robot.drive(v * self.robot_config.max_speed, w * self.robot_config.max_yaw_rate)
         collision = self.sim.step(self.physics_substeps)
         self.pose = robot.pose()
         if "odometry" in self.obs_keys:
-            self.odometry.update(robot.wheel_angles(), self.np_random)
+            self.odometry.update(robot.encoders(), self.np_random)
         self._panorama = None
         skip_images, self._skip_images = self._skip_images, False
         self.trajectory.append((float(self.pose[0]), float(self.pose[1])))

@@ -109,7 +109,10 @@ class LocalHomingEnv(HomingEnv):
     ``action_type``, ``control_period`` (at most 2 s), ``physics_substeps`` (1-1000; each
     physics step between 1/2000 and 1/60 s), ``max_speed``,
     ``max_yaw_rate``, ``stop_threshold``, ``odometry_noise`` = 0.02,
-    ``odometry_origin`` = ``"start"`` (or ``"home"``), ``goal_step_length`` = 0.15,
+    ``odometry_origin`` = ``"start"`` (or ``"home"``), ``drive`` = ``"differential"``
+    (or ``"synchro"``: the body translates without turning, as Hong et al.'s robot; the
+    continuous action is then the body-frame velocity ``(vx, vy)``, speed at most
+    ``max_speed``; see :mod:`homing_gym.robot`), ``goal_step_length`` = 0.15,
     ``lighting_change`` = 0
     (0-1: strength of an illumination change between the home snapshot and the run, drawn
     from the seed: light direction, brightness, contrast),

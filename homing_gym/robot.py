@@ -1,12 +1,27 @@
-"""The differential-drive robot: URDF loading, unicycle control and wheel odometry.
+"""The robot: URDF loading, its two drives and their odometry.
 
 Frame conventions (used everywhere in homing-gym): world x, y on the floor, z up;
 a pose is ``(x, y, yaw)`` in metres and radians, yaw counter-clockwise from world +x.
 The robot's own frame has x forward, y to the left.
+
+Drives (``RobotConfig.drive``):
+
+* ``"differential"`` (default): two driven wheels and a caster; the command is a forward
+  speed and a yaw rate (unicycle model), executed by the wheel motors.
+* ``"synchro"``: a synchro-drive base, as Hong et al.'s robot (1991, §3: "the robot does
+  not rotate"): all wheels steer together, so the body translates in any direction and
+  keeps its heading. The command is a velocity ``(vx, vy)`` in the body frame. Simulated
+  kinematically: every physics step the base is given the commanded velocity (ramped by
+  ``wheel_acceleration``, as the differential motors are), no angular velocity, and
+  frictionless wheels; walls and landmarks still stop it (the contact solver). Its
+  odometry integrates the commanded travel (the driven wheels turn as commanded; pushed
+  against a wall they slip, as real wheels do), each increment scaled by
+  ``1 + N(0, noise)``, at the fixed heading.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from importlib import resources
 
@@ -17,6 +32,7 @@ from pybullet_utils.bullet_client import BulletClient
 from homing_gym.geometry import wrap_angle
 
 URDF_PATH = str(resources.files("homing_gym") / "assets" / "robot.urdf")
+DRIVES = ("differential", "synchro")
 
 
 @dataclass(frozen=True)
@@ -38,6 +54,11 @@ class RobotConfig:
     max_yaw_rate: float = 1.5
     wheel_torque: float = 2.0
     wheel_acceleration: float = 2.0
+    drive: str = "differential"
+
+    def __post_init__(self) -> None:
+        if self.drive not in DRIVES:
+            raise ValueError(f"unknown drive {self.drive!r}; allowed: {DRIVES}")
 
     @property
     def max_wheel_speed(self) -> float:
@@ -71,13 +92,19 @@ class Robot:
         client.changeDynamics(self.body_id, self.caster_link, lateralFriction=0.0,
                               spinningFriction=0.0, rollingFriction=0.0)
         client.changeDynamics(self.body_id, -1, lateralFriction=0.3)
+        self.synchro = config.drive == "synchro"
+        if self.synchro:      # driven kinematically: no wheel friction, no wheel motors
+            for link in (-1, *self.wheel_joints):
+                client.changeDynamics(self.body_id, link, lateralFriction=0.0)
         # PyBullet places a base by its centre of mass; keep the URDF link frame instead.
         info = client.getDynamicsInfo(self.body_id, -1)
         self._com_in_link = (info[3], info[4])
         self._link_in_com = client.invertTransform(*self._com_in_link)
         self._target = [0.0, 0.0]
         self._current = [0.0, 0.0]
-        self._forces = [config.wheel_torque] * 2
+        self._forces = [0.0 if self.synchro else config.wheel_torque] * 2
+        self._heading = 0.0                   # synchro: the fixed body heading (radians)
+        self._travel = np.zeros(2)            # synchro: commanded travel, body frame (m)
         self._set_motors = client.setJointMotorControlArray
 
     def set_pose(self, x: float, y: float, yaw: float) -> None:
@@ -90,20 +117,34 @@ class Robot:
         for j in self.wheel_joints:
             self.client.resetJointState(self.body_id, j, 0.0, 0.0)
         self._current = [0.0, 0.0]
-        self.drive(0.0, 0.0)
+        self._heading = float(yaw)
+        self._target = [0.0, 0.0]
         self.update_motors(0.0)
         # Refresh the contact cache at the new pose: without this, contacts remembered from
         # before the teleport make the next steps depend on the previous episode.
         self.client.performCollisionDetection()
 
     def drive(self, v: float, w: float) -> None:
-        """Command forward speed ``v`` (m/s) and yaw rate ``w`` (rad/s); the wheel motors
-        ramp towards it in :meth:`update_motors`."""
+        """Differential drive: command forward speed ``v`` (m/s) and yaw rate ``w``
+        (rad/s); the wheel motors ramp towards it in :meth:`update_motors`."""
+        if self.synchro:
+            raise ValueError("a synchro-drive robot takes drive_planar(vx, vy), not drive(v, w)")
         self._target = list(wheel_speeds(v, w, self.config))
 
+    def drive_planar(self, vx: float, vy: float) -> None:
+        """Synchro drive: command the velocity ``(vx, vy)`` (m/s, body frame: x forward,
+        y left); the base ramps towards it in :meth:`update_motors`."""
+        if not self.synchro:
+            raise ValueError("a differential-drive robot takes drive(v, w), not drive_planar")
+        self._target = [float(vx), float(vy)]
+
     def update_motors(self, dt: float) -> None:
-        """Move the wheel motor targets towards the command by one ramp step of ``dt`` s
-        (called before every physics step; plain floats, as it runs 240 times a second)."""
+        """Move the wheel motor targets (differential) or the base velocity (synchro)
+        towards the command by one ramp step of ``dt`` s (called before every physics
+        step; plain floats, as it runs 240 times a second)."""
+        if self.synchro:
+            self._update_synchro(dt)
+            return
         if self._current == self._target and dt > 0:
             return
         limit = self.config.wheel_acceleration / self.config.wheel_radius * dt
@@ -111,6 +152,27 @@ class Robot:
                          for c, t in zip(self._current, self._target)]
         self._set_motors(self.body_id, self.wheel_joints, p.VELOCITY_CONTROL,
                          targetVelocities=self._current, forces=self._forces)
+
+    def _update_synchro(self, dt: float) -> None:
+        (vx, vy), (tx, ty) = self._current, self._target
+        gap = math.hypot(tx - vx, ty - vy)
+        limit = self.config.wheel_acceleration * dt
+        if gap > limit:
+            vx, vy = vx + (tx - vx) * limit / gap, vy + (ty - vy) * limit / gap
+        else:
+            vx, vy = tx, ty
+        self._current = [vx, vy]
+        self._travel += (vx * dt, vy * dt)
+        c, s = math.cos(self._heading), math.sin(self._heading)
+        vz = self.client.getBaseVelocity(self.body_id)[0][2]
+        self.client.resetBaseVelocity(self.body_id, [c * vx - s * vy, s * vx + c * vy, vz],
+                                      [0.0, 0.0, 0.0])
+
+    def encoders(self) -> np.ndarray:
+        """The odometry's raw readings: (left, right) wheel joint angles (radians) of the
+        differential drive; the synchro drive's commanded travel ``(x, y)`` (metres, body
+        frame) since the last teleport."""
+        return self._travel.copy() if self.synchro else self.wheel_angles()
 
     def pose(self) -> np.ndarray:
         """True pose ``(x, y, yaw)`` of the body centre on the floor (float64)."""
@@ -144,7 +206,7 @@ class WheelOdometry:
         self._last_angles = np.zeros(2)
 
     def reset(self, initial: np.ndarray, wheel_angles: np.ndarray) -> None:
-        """Start integrating from ``initial`` (home-frame pose) at the given encoder angles."""
+        """Start integrating from ``initial`` (pose) at the given encoder readings."""
         self.estimate = np.asarray(initial, dtype=np.float64).copy()
         self._last_angles = wheel_angles.copy()
 
@@ -163,3 +225,25 @@ class WheelOdometry:
             wrap_angle(self.estimate[2] + dyaw),
         ])
         return self.estimate
+
+
+class SynchroOdometry(WheelOdometry):
+    """Path integration of the synchro drive: each control step the commanded travel
+    since the last call (body frame; :meth:`Robot.encoders`) is scaled by
+    ``1 + N(0, noise)`` and added at the estimate's heading, which never changes (the
+    body does not rotate)."""
+
+    def update(self, travel: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        delta = travel - self._last_angles
+        self._last_angles = travel.copy()
+        if self.noise > 0:
+            delta = delta * (1.0 + rng.normal(0.0, self.noise))
+        c, s = np.cos(self.estimate[2]), np.sin(self.estimate[2])
+        self.estimate = self.estimate + (c * delta[0] - s * delta[1],
+                                         s * delta[0] + c * delta[1], 0.0)
+        return self.estimate
+
+
+def odometry_for(config: RobotConfig, noise: float) -> WheelOdometry:
+    """The odometry of ``config``'s drive, with multiplicative encoder ``noise``."""
+    return (SynchroOdometry if config.drive == "synchro" else WheelOdometry)(config, noise)

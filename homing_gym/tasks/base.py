@@ -25,6 +25,9 @@ class Task(ABC):
     #: Clear PyBullet's cached contacts when the robot is put at the start (episodes that
     #: may start where the last one ended, see ``LongRangeHomingTask``).
     fresh_contacts: ClassVar[bool] = False
+    #: The task commands the robot itself in some phase (unicycle commands from
+    #: :meth:`command`), so the synchro drive is not available with it.
+    drives_robot: ClassVar[bool] = False
 
     @abstractmethod
     def sample_episode(self, scene: Scene, rng: np.random.Generator) -> Episode:

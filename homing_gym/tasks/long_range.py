@@ -83,6 +83,7 @@ class LongRangeHomingTask(GoalReachingTask):
     :class:`GoalReachingTask`."""
 
     fresh_contacts = True
+    drives_robot = True
 
     def __init__(self, route_length: float = 8.0, outbound_speed: float = 0.15,
                  outbound_yaw_rate: float = 0.5, success_radius: float = 0.2,

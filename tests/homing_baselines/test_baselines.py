@@ -2,6 +2,7 @@
 
 import math
 
+import numpy as np
 import pytest
 
 import homing_baselines
@@ -10,6 +11,19 @@ from homing_train.harness.evaluate import run_episode
 from homing_train.harness.policies import parse_params
 
 ENV_ID = "homing_gym/LocalHoming-v0"
+
+
+@pytest.mark.parametrize("style", ["turn_then_drive", "pursuit"])
+def test_motion_helper_translates_on_a_synchro_drive(style):
+    helper = MotionHelper(MotionSpec(drive="synchro"), style)
+    actions = helper.plan(Move(0.7, 0.1))            # 0.1 m at 0.03 m per step: 4 steps
+    assert len(actions) == 4
+    for a in actions:                                # the body-frame velocity, 5/6 speed
+        assert np.allclose(a, [0.1 / 0.12 * math.cos(0.7), 0.1 / 0.12 * math.sin(0.7)],
+                           atol=1e-6)
+    assert helper.plan(Move(1.0, 0.0)) == []         # cannot turn on the spot
+    with pytest.raises(ValueError, match="continuous"):
+        MotionHelper(MotionSpec(action_type="discrete", drive="synchro"))
 
 
 def test_registry_lists_and_makes_controllers():

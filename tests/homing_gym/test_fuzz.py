@@ -44,6 +44,7 @@ BAD_KWARGS = [
     {"reward": {"progress": "x"}}, {"reward": {"progress": NAN}}, {"stop_threshold": 2},
     {"vfov_deg": 500}, {"renderer": "nope"}, {"omni_size": 3},
     {"max_episode_steps": 0}, {"max_episode_steps": 2.5}, {"odometry_origin": "goal"},
+    {"drive": "tank"}, {"drive": "synchro", "action_type": "discrete"},
 ]
 BAD_COMMANDS = [   # (module of the command, arguments)
     ("homing_train.harness.eval_command", ["--policy", "nope", "--out", "{tmp}/r.json"]),

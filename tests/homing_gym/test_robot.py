@@ -113,3 +113,29 @@ def test_odometry_noise_makes_estimates_drift(make_env):
         a, _, _, _, _ = clean.step(np.array([0.0, 1.0], np.float32))
         b, _, _, _, _ = noisy.step(np.array([0.0, 1.0], np.float32))
     assert not np.allclose(a["odometry"], b["odometry"], atol=1e-3)
+
+
+def test_synchro_drive_translates_without_turning_and_its_odometry_follows(make_env):
+    env = make_env(drive="synchro", obs_keys=("panorama", "odometry"), odometry_noise=0.0,
+                   panorama_shape=(16, 64), scene="arena")
+    obs, info = env.reset(seed=0, options={"start": (0.7, -0.1, 0.7), "home": (0.8, 0.8, 0)})
+    start = info["pose"].copy()
+    for action, steps in (((0.0, 1.0), 5), ((1.0, 0.0), 5), ((-0.7, -0.7), 5), ((0, 0), 3)):
+        for _ in range(steps):
+            obs, _, _, _, info = env.step(np.array(action, np.float32))
+            assert not info["collision"]
+    moved = to_frame(start, info["pose"])
+    assert abs(moved[2]) < 1e-6                              # the body never turned
+    # 0.3 m/s for 0.5 s each way, less the acceleration ramps; (-0.7, -0.7) goes back
+    # at 0.3 m/s along the diagonal: about (0.15 - 0.074, 0.15 - 0.074) in the body frame
+    assert moved[0] == pytest.approx(moved[1], abs=0.005) and 0.04 < moved[0] < 0.1
+    assert np.allclose(obs["odometry"], moved, atol=1e-4)
+
+
+def test_synchro_drive_refuses_what_it_cannot_do(make_env):
+    with pytest.raises(ValueError, match="continuous"):
+        make_env(drive="synchro", action_type="discrete")
+    with pytest.raises(ValueError, match="task drives the robot itself"):
+        make_env("homing_gym/LongRangeHoming-v0", drive="synchro")
+    with pytest.raises(ValueError, match="unknown drive 'tank'"):
+        make_env(drive="tank")

@@ -84,6 +84,26 @@ def marked_goal_starts(scene: str, per_goal: int, seed: int, goal_yaw: float,
     return tasks
 
 
+def common_heading_starts(scene: str, distance: float, n: int, seed: int,
+                          margin: float = 0.25) -> list[Task]:
+    """``n`` episodes with a random home (uniform over the scene, random heading) and a
+    start ``distance`` metres from it in a random direction *with the home's heading*
+    (Hong et al.: the robot does not rotate), both with ``margin`` metres of clearance.
+    Seeds ``seed + i``."""
+    world = scene_named(scene)
+    rng = np.random.default_rng(seed)
+    (xmin, ymin), (xmax, ymax) = world.bounds
+    tasks: list[Task] = []
+    while len(tasks) < n:
+        yaw = float(rng.uniform(-np.pi, np.pi))
+        home = (float(rng.uniform(xmin, xmax)), float(rng.uniform(ymin, ymax)), yaw)
+        a = rng.uniform(-np.pi, np.pi)
+        start = (home[0] + distance * math.cos(a), home[1] + distance * math.sin(a), yaw)
+        if min(clearance(world, home[:2]), clearance(world, start[:2])) >= margin:
+            tasks.append((seed + len(tasks), start, home))
+    return tasks
+
+
 @dataclass(frozen=True)
 class Setting:
     """One part of a protocol: ``env_id`` with ``env_kwargs`` (``success_on="stop"`` is
@@ -131,6 +151,10 @@ class Protocol:
         return f"homing-eval --protocol {self.name} --policy {method}{extra} --out OUT.json"
 
 
+def _hong_one_foot(episodes: int, seed: int) -> list[Task]:
+    return common_heading_starts("hallway", FOOT, episodes, seed)
+
+
 def _yukim_nest(episodes: int, seed: int) -> list[Task]:
     bins = ((0.3, 0.6), (0.6, 0.9), (0.9, 1.2), (1.2, 1.4))
     return ring_starts("arena", NEST, bins, max(1, math.ceil(episodes / len(bins))), seed)
@@ -140,6 +164,8 @@ def _bekris_goals(episodes: int, seed: int) -> list[Task]:
     return marked_goal_starts("lab", max(1, math.ceil(episodes / 6)), seed, goal_yaw=0.5)
 
 
+#: Hong et al.'s step between snapshots, and the start distance of their demonstration (§5).
+FOOT = 0.3048
 #: Yu & Kim's nest: the arena's centre, among the four cylinders (§IV).
 NEST = (0.0, 0.0, 0.0)
 LOCAL = "homing_gym/LocalHoming-v0"
@@ -149,6 +175,16 @@ HOMING_METHODS = ("oracle", "random", "snapshot", "warping", "distance", POLICIE
 UNSEEN_SEED = 10_000_000
 
 PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
+    Protocol(
+        "hong1991", 1, "Hong et al.: the hallway, a synchro-drive robot (it translates "
+        "without turning), starts 1 ft (0.3048 m) from a random home with the home's "
+        "heading; panorama 60 x 360 (1 deg per column)",
+        (Setting("hallway, 1 ft", LOCAL,
+                 {"scene": "hallway", "drive": "synchro", "panorama_shape": [60, 360],
+                  "max_episode_steps": 200}, _hong_one_foot),),
+        ("snapshot", "warping", "oracle", "random"), episodes=10,
+        paper="§5: a 17-target route, targets 1 ft apart, traversed: every 1-ft homing "
+              "succeeded (>= 95% expected)"),
     Protocol(
         "yukim", 1, "Yu & Kim: the arena, the nest among the four landmarks, starts "
         "0.3-1.4 m away in the four distance bins of Fig. 6, random headings",

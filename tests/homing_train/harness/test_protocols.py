@@ -118,3 +118,21 @@ def test_matrix_files_name_every_cell_with_its_command(tmp_path):
     assert "`homing-eval --protocol yukim --policy distance --out OUT.json`" in text
     assert open(written["csv"]).read().count("\n") == 3
     assert open(written["png"], "rb").read(4) == b"\x89PNG"
+
+
+def test_hong_starts_are_one_foot_from_home_with_the_homes_heading():
+    from homing_train.harness.protocols import FOOT, common_heading_starts
+
+    hallway = scene_named("hallway")
+    for _, start, home in common_heading_starts("hallway", FOOT, 8, seed=2):
+        assert math.dist(start[:2], home[:2]) == pytest.approx(0.3048)
+        assert start[2] == home[2]
+        assert min(clearance(hallway, start[:2]), clearance(hallway, home[:2])) >= 0.25
+
+
+@pytest.mark.slow
+def test_snapshot_homes_from_one_foot_on_the_synchro_drive(tmp_path):
+    cell = run_cell(protocol("hong1991"), "snapshot", tmp_path, episodes=6, workers=2,
+                    progress=False)
+    # closed loop on the paper's robot and step; 8 of 10 in the docs' run
+    assert cell.summary["success_rate"] >= 0.5, cell.summary
