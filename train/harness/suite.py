@@ -91,6 +91,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--workers", type=int, default=2, help="parallel processes")
     parser.add_argument("--methods", nargs="+", help="subset of methods (default: all)")
     parser.add_argument("--out", default="results", help="output folder (default: results)")
+    parser.add_argument("--resume", action="store_true",
+                        help="with --protocols: keep the episodes already streamed into --out "
+                        "(an interrupted matrix, or one to which protocols were added) and "
+                        "run only the others")
     add_backend_arguments(parser)
     args = parser.parse_args(argv)
     if (args.episodes is not None and args.episodes < 1) or args.workers < 1:
@@ -100,7 +104,8 @@ def main(argv: list[str] | None = None) -> int:
             names = sorted(PROTOCOLS) if args.protocols == ["all"] else args.protocols
             chosen = [protocol(name) for name in names]
             cells = run_matrix(chosen, Path(args.out), args.episodes, args.workers,
-                               args.methods, backend=args.backend, address=args.ray_address)
+                               args.methods, resume=args.resume, backend=args.backend,
+                               address=args.ray_address)
         except ValueError as err:
             parser.exit(2, f"homing-suite: error: {err}\n")
         print(matrix_markdown(cells))
