@@ -7,9 +7,11 @@ episodes, the methods it applies to, and the paper's claim to set beside our num
 
 **One success rule for every row**: every setting runs with ``success_on="stop"``: an
 episode succeeds when the agent itself declares arrival (its stop action, or a
-continuous action below the stop threshold) within ``success_radius`` (0.15 m unless
-the protocol says otherwise) of the goal. "Reached" (a second column) counts episodes
-that came within that radius at any time, stopped or not.
+continuous action below the stop threshold) within ``success_radius`` of the goal: 0.15 m,
+0.10 m in ``shiraishi-house`` (the WorkLocations env's radius, the paper's 10 cm); in
+``briggs-corridors`` the place is the task's own ("in front of the landmark",
+``Protocol.place``). "Reached" (a second column) counts episodes that came within the
+radius at any time, stopped or not (not given where the place rule is not a radius).
 
 ``homing-eval --protocol NAME --policy METHOD`` runs one method on a protocol;
 ``homing-suite --protocols ...`` runs every applicable method on each and writes the
@@ -137,6 +139,7 @@ class Protocol:
     seed: int = 0
     paper: str = ""                    # the paper's claim, beside our number
     privileged: str = ""               # anything beyond pixels the protocol gives
+    place: str = ""                    # a place rule other than the radius (the task's)
 
     @property
     def label(self) -> str:
@@ -209,10 +212,14 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
         "briggs-corridors", 1, "Briggs et al.: LandmarkNavigation-v0 in the corridors",
         (Setting("corridors", "homing_gym/LandmarkNavigation-v0", {"scene": "corridors"}),),
         ("selfsimilar", "oracle", "random"), episodes=6,
+        place="stopped in front of the goal landmark (the task's rule: at most 1.2 m from "
+              "the panel, within 30 deg of its normal, facing it)",
         paper="§5: the robot reached its goal landmarks in the building's corridors"),
     Protocol(
-        "shiraishi-house", 1, "Shiraishi & Sawasaki: WorkLocations-v0 in the house",
-        (Setting("house", "homing_gym/WorkLocations-v0", {"scene": "house"}),),
+        "shiraishi-house", 1, "Shiraishi & Sawasaki: WorkLocations-v0 in the house, "
+        "success radius 0.10 m (the env's and the paper's)",
+        (Setting("house", "homing_gym/WorkLocations-v0",
+                 {"scene": "house", "success_radius": 0.1}),),
         ("multires", "oracle", "random"), episodes=6,
         paper="§4: arrival within 10 cm and 2 deg of each work location"),
     Protocol(

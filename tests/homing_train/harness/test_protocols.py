@@ -136,3 +136,21 @@ def test_snapshot_homes_from_one_foot_on_the_synchro_drive(tmp_path):
                     progress=False)
     # closed loop on the paper's robot and step; 8 of 10 in the docs' run
     assert cell.summary["success_rate"] >= 0.5, cell.summary
+
+
+def test_readme_matrix_is_the_committed_matrix_with_every_cells_command():
+    from pathlib import Path
+
+    from homing_train.harness.matrix import (README_BEGIN, README_END, load_cells,
+                                             matrix_markdown, readme_block)
+
+    root = Path(__file__).resolve().parents[3]
+    text = (root / "README.md").read_text()
+    block = README_BEGIN + text.split(README_BEGIN)[1].split(README_END)[0] + README_END
+    cells = load_cells(root / "docs/matrix/matrix.json")
+    assert block == readme_block(cells, "docs/matrix/matrix.json")
+    full = (root / "docs/matrix/matrix.md").read_text()
+    assert full == matrix_markdown(cells)
+    for c in cells:
+        assert c.command.startswith(f"homing-eval --protocol {c.protocol} --policy {c.method}")
+        assert f"`{c.command}`" in full and c.version == protocol(c.protocol).version
