@@ -58,7 +58,7 @@ def test_landmark_navigation_takes_a_reward_mapping():
 @pytest.mark.slow
 def test_a_worker_that_cannot_start_ends_the_evaluation_once():
     out = subprocess.run(
-        [sys.executable, "-m", "homing_train.harness.evaluate", "--policy", "random",
+        [sys.executable, "-m", "homing_train.harness.eval_command", "--policy", "random",
          "--episodes", "4", "--workers", "2", "--quiet", "--env-kwargs",
          '{"scene": "nowhere"}', "--out", "/tmp/never.json"],
         capture_output=True, text=True, timeout=180)

@@ -189,13 +189,17 @@ def run_eval(names: list[str], episodes: int = 200) -> dict[str, Any]:
     return res
 
 
-def run_routes(names: list[str], episodes: int = 20) -> dict[str, Any]:
+def run_routes(names: list[str], episodes: int = 20,
+               drive: str = "differential") -> dict[str, Any]:
     """RouteFollowing-v0, ``success_on="stop"``: share of routes with all 17 targets
-    reached (every stop within the 0.1 m radius) and mean per-target error."""
+    reached (every stop within the 0.1 m radius) and mean per-target error; with
+    ``drive="synchro"`` on Hong's robot, which translates without turning (keys end in
+    ``/synchro``)."""
     res = {}
     for name in names:
         for light in (0.0, 0.5):
-            kw = {"panorama_shape": PANORAMA, "success_on": "stop", "lighting_change": light}
+            kw = {"panorama_shape": PANORAMA, "success_on": "stop", "lighting_change": light,
+                  "drive": drive}
             env = gym.make(ROUTE, **kw)
             radius = env.unwrapped.task.success_radius
             policy = policy_spec(name).build()
@@ -209,7 +213,7 @@ def run_routes(names: list[str], episodes: int = 20) -> dict[str, Any]:
                 all_ok.append(len(errs) == 17 and max(errs) < radius)
                 last_ok.append(bool(info["is_success"]))
             env.close()
-            res[f"{name}/lighting={light}"] = {
+            res[f"{name}/lighting={light}" + ("/synchro" if drive == "synchro" else "")] = {
                 "all_17_within_radius": float(np.mean(all_ok)),
                 "episode_success": float(np.mean(last_ok)),
                 "mean_target_error_m": float(np.mean(errors)) if errors else None,
@@ -269,6 +273,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--tables", action="store_true",
                         help="only print the Markdown tables of an existing results.json")
     parser.add_argument("--routes", type=int, default=20)
+    parser.add_argument("--drive", choices=["differential", "synchro"], default="differential",
+                        help="the robot of the route runs (synchro: Hong's, never turns)")
     args = parser.parse_args(argv)
     gym.register_envs(homing_gym)
     os.makedirs(args.out, exist_ok=True)
@@ -285,7 +291,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"methods: {names}")
     steps = {"signature": lambda: plot_signature(args.out), "sweep": lambda: run_sweep(), "field": lambda: run_fields(args.out, names),
              "eval": lambda: run_eval(names, args.episodes),
-             "route": lambda: run_routes(names, args.routes)}
+             "route": lambda: run_routes(names, args.routes, args.drive)}
     for key in args.only:
         value = steps[key]()
         if key in PER_METHOD and isinstance(results.get(key), dict):
