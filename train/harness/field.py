@@ -41,6 +41,7 @@ from homing_train.harness.evaluate import (DEFAULT_ENV, add_policy_arguments,  #
                                            parse_json_kwargs, policy_from_args, run_episodes)
 from homing_train.harness.palette import HOME_MARK  # noqa: E402
 from homing_train.harness.policies import PolicySpec, policy_spec  # noqa: E402
+from homing_train.harness.protocols import PROTOCOLS, protocol  # noqa: E402
 from homing_train.harness.rollout import prepare_policy, rollout  # noqa: E402
 
 # colour-blind-safe (Okabe & Ito): returned blue, not returned vermillion, unknown grey
@@ -84,7 +85,8 @@ PROBE_STEPS = 40
 
 
 def first_home_decision(env: gym.Env, controller, pose, seed: int,
-                        max_steps: int = PROBE_STEPS) -> tuple[np.ndarray, float | None]:
+                        max_steps: int = PROBE_STEPS,
+                        home=None) -> tuple[np.ndarray, float | None]:
     """Start an episode at ``pose`` and run the controller until it states a home
     direction (at once for most methods; after its measuring step for distance estimation,
     as in Yu & Kim Fig. 10). Returns the robot pose at that decision and the direction
@@ -98,16 +100,19 @@ def first_home_decision(env: gym.Env, controller, pose, seed: int,
                          controller.last_home_direction))
         return True
 
-    rollout(env, controller, seed, {"start": [float(v) for v in pose]}, on_step=stated,
-            max_steps=max_steps)
+    options = {"start": [float(v) for v in pose]}
+    if home is not None:
+        options["home"] = [float(v) for v in home]
+    rollout(env, controller, seed, options, on_step=stated, max_steps=max_steps)
     return decision[0] if decision else (np.asarray(pose, dtype=np.float64), None)
 
 
 def homing_field(policy, env_id: str = DEFAULT_ENV, grid: float = 0.2, seed: int = 0,
                  env_kwargs: dict[str, Any] | None = None, margin: float = 0.22,
                  run_to_end: bool = True, workers: int = 1, progress: bool = True,
-                 params: dict[str, Any] | None = None) -> FieldResult:
-    """Compute the vector field of ``policy`` in the scene and home of episode ``seed``."""
+                 params: dict[str, Any] | None = None, home=None) -> FieldResult:
+    """Compute the vector field of ``policy`` in the scene and home of episode ``seed``
+    (``home``: a fixed home pose (x, y, yaw) instead)."""
     spec: PolicySpec = policy_spec(policy, params)
     if spec.kind != "controller":
         raise ValueError("homing-field needs a scripted controller that reports its home "
@@ -115,7 +120,7 @@ def homing_field(policy, env_id: str = DEFAULT_ENV, grid: float = 0.2, seed: int
     env_kwargs = dict(env_kwargs or {})
     env = gym.make(env_id, **env_kwargs)
     try:
-        _, info = env.reset(seed=seed)
+        _, info = env.reset(seed=seed, options=None if home is None else {"home": home})
         u = env.unwrapped
         home = np.asarray(info["home_pose"], dtype=np.float64)
         radius = getattr(u.task, "success_radius", 0.15)
@@ -128,7 +133,8 @@ def homing_field(policy, env_id: str = DEFAULT_ENV, grid: float = 0.2, seed: int
         prepare_policy(controller, env)
         commanded, true_dir = [], []
         for pose in points:
-            decision_pose, direction = first_home_decision(env, controller, pose, seed)
+            decision_pose, direction = first_home_decision(env, controller, pose, seed,
+                                                           home=home)
             commanded.append(math.nan if direction is None
                              else wrap_angle(decision_pose[2] + direction))
             true_dir.append(math.atan2(home[1] - decision_pose[1], home[0] - decision_pose[0]))
@@ -140,7 +146,9 @@ def homing_field(policy, env_id: str = DEFAULT_ENV, grid: float = 0.2, seed: int
     err = np.abs(wrap_angle(cmd[valid] - true[valid])) if valid.any() else np.array([np.pi])
     returned = None
     if run_to_end:
-        records = run_episodes(spec, env_id, env_kwargs, [(seed, p) for p in points],
+        records = run_episodes(spec, env_id, env_kwargs,
+                               [(seed, p, None if home is None else tuple(home))
+                                for p in points],
                                workers, progress, desc=f"{spec.label} field")
         returned = [r.success for r in records]
     result = FieldResult(
@@ -190,6 +198,9 @@ def main(argv: list[str] | None = None) -> int:
     parser = command_parser("homing-field", __doc__)
     add_policy_arguments(parser)
     parser.add_argument("--scene", default=None, help="scene name (overrides --env-kwargs)")
+    parser.add_argument("--protocol", choices=sorted(PROTOCOLS),
+                        help="the field in this protocol's first setting: its env, env kwargs "
+                        "and its first episode's home")
     parser.add_argument("--grid", type=float, default=0.2, help="grid spacing (m)")
     parser.add_argument("--no-return", action="store_true",
                         help="skip the return-ratio runs (arrows only, fast)")
@@ -197,11 +208,20 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         env_kwargs = parse_json_kwargs(args.env_kwargs)
+        env_id, seed, home = args.env, args.seed, None
+        if args.protocol:
+            if args.env != DEFAULT_ENV or env_kwargs or args.scene or args.seed != 0:
+                raise ValueError("--protocol fixes the env, its kwargs and the home; drop "
+                                 "--env/--env-kwargs/--scene/--seed")
+            chosen = protocol(args.protocol)
+            setting = chosen.settings[0]
+            env_id, env_kwargs = setting.env_id, setting.kwargs()
+            seed, _, home = setting.episode_tasks(1, chosen.seed)[0]
         if args.scene:
             env_kwargs["scene"] = args.scene
-        result = homing_field(policy_from_args(args), args.env, args.grid, args.seed,
+        result = homing_field(policy_from_args(args), env_id, args.grid, seed,
                               env_kwargs, run_to_end=not args.no_return,
-                              workers=args.workers, progress=not args.quiet)
+                              workers=args.workers, progress=not args.quiet, home=home)
     except ValueError as err:
         parser.exit(2, f"homing-field: error: {err}\n")
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)

@@ -154,3 +154,17 @@ def test_readme_matrix_is_the_committed_matrix_with_every_cells_command():
     for c in cells:
         assert c.command.startswith(f"homing-eval --protocol {c.protocol} --policy {c.method}")
         assert f"`{c.command}`" in full and c.version == protocol(c.protocol).version
+
+
+def test_field_in_a_protocol_uses_its_env_and_fixed_home(tmp_path):
+    from homing_train.harness import field
+
+    out = tmp_path / "f.png"
+    assert field.main(["--protocol", "yukim", "--policy", "warping", "--grid", "0.8",
+                       "--no-return", "--quiet", "--out", str(out)]) == 0
+    doc = json.loads(out.with_suffix(".json").read_text())
+    assert np.allclose(doc["home"][:2], NEST[:2])            # Yu & Kim's nest, not a drawn home
+    assert doc["env_kwargs"]["success_on"] == "stop" and doc["env_kwargs"]["scene"] == "arena"
+    with pytest.raises(SystemExit):
+        field.main(["--protocol", "yukim", "--policy", "warping", "--scene", "lab",
+                    "--out", str(out)])
