@@ -518,3 +518,8 @@ def format_summary(result: EvalResult) -> str:
             f"{s['final_distance_cm_median']:.1f}), heading error "
             f"{s['heading_error_deg_mean']:.1f} deg, collisions/episode "
             f"{s['collisions_mean']:.2f}")
+
+
+if __name__ == "__main__":
+    raise SystemExit("homing-eval's command line is python -m homing_train.harness.eval_command "
+                     "(or the homing-eval command)")
