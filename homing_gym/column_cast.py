@@ -114,11 +114,15 @@ def _span(p: np.ndarray, yaw: float):
 
 
 @njit(cache=True, error_model="numpy")
-def cast_columns(tris: np.ndarray, origin: np.ndarray, yaw: float, beta: np.ndarray,
-                 tan_elev: np.ndarray, hit: np.ndarray, weights: np.ndarray) -> None:
+def cast_columns(tris: np.ndarray, normals: np.ndarray, closed: np.ndarray,
+                 origin: np.ndarray, yaw: float, beta: np.ndarray, tan_elev: np.ndarray,
+                 hit: np.ndarray, weights: np.ndarray) -> None:
     """Nearest triangle per pixel.
 
-    ``tris (N, 3, 3)`` world corners (metres); ``origin (3,)`` the camera; ``yaw`` its
+    ``tris (N, 3, 3)`` world corners (metres); ``normals (N, 3)`` their normals;
+    ``closed (N,)``: the triangle bounds a closed solid and its normal points out, so
+    it is skipped when turned away from the camera (hidden by the solid's near side
+    whenever the camera is outside the solid); ``origin (3,)`` the camera; ``yaw`` its
     heading (radians); ``beta (W,)`` column bearings relative to the heading, strictly
     descending within ``(-pi, pi]``; ``tan_elev (H, W)`` tangent of each pixel's ray
     elevation, descending down each column. Writes ``hit (H, W)`` the triangle index
@@ -135,6 +139,9 @@ def cast_columns(tris: np.ndarray, origin: np.ndarray, yaw: float, beta: np.ndar
         for k in range(3):
             for d in range(3):
                 p[k, d] = tris[t, k, d] - origin[d]
+        if closed[t] and (normals[t, 0] * p[0, 0] + normals[t, 1] * p[0, 1]
+                          + normals[t, 2] * p[0, 2]) >= 0.0:
+            continue
         lo, hi, everywhere = _span(p, yaw)
         if lo > hi:
             continue

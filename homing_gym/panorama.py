@@ -77,7 +77,7 @@ class CameraConfig:
     far: float = 30.0
     omni_size: int = 128
     signature_rows: int = 5
-    renderer: str = "tiny"
+    renderer: str = "raycast"
 
     def __post_init__(self) -> None:
         shape = self.panorama_shape

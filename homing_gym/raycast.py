@@ -8,9 +8,11 @@ counter-clockwise from the heading, row ``i`` the elevation
 ``vfov/2 - vfov*(i + 0.5)/H``; no resampling. Perspective rays are those of an upright
 pinhole with square pixels (:class:`~homing_gym.perspective.PerspectiveConfig`), through
 pixel centres. Shading: the triangle's colour, times its texture (nearest texel) if it has
-one, times ``ambient + diffuse * |n . l|`` (two-sided Lambert with the
-:class:`~homing_gym.panorama.Lighting` direction), clipped, then the lighting's
-brightness/contrast change; rays that hit nothing see ``sky_color``. With
+one, times ``ambient + diffuse * max(0, n . l)`` (Lambert with the
+:class:`~homing_gym.panorama.Lighting` direction ``l``, ``n`` the face's normal on the
+side the camera sees: a face turned away from the light gets the ambient term alone, as
+in TinyRenderer, so walls of different orientation differ in brightness), clipped, then
+the lighting's brightness/contrast change; rays that hit nothing see ``sky_color``. With
 ``supersampling = k`` each pixel averages ``k x k`` rays spread evenly over its area. The
 robot's own body is not part of the world mesh, so it never occludes the camera. The
 same pose gives the same pixels.
@@ -26,6 +28,7 @@ from __future__ import annotations
 
 from functools import lru_cache
 
+import cv2
 import numpy as np
 
 from homing_gym.column_cast import cast_columns, shade
@@ -75,6 +78,7 @@ class RayCaster:
         self.sky = np.asarray(sky_color, np.float64)
         self._tris = mesh.triangles.astype(np.float64)
         self._normals = mesh.normals.astype(np.float64)
+        self._closed = mesh.closed.astype(np.bool_)
         self._uvs = mesh.uvs.astype(np.float64)
         self._texture = mesh.texture.astype(np.int64)
         sizes = [t.size for t in mesh.textures]
@@ -85,10 +89,13 @@ class RayCaster:
                                     for o, t in zip(offsets, mesh.textures)],
                                    np.int64).reshape(-1, 3)
 
-    def _lit_colors(self, lighting: Lighting) -> np.ndarray:
-        """Each triangle's colour times ``ambient + diffuse * |n . l|`` (before textures)."""
+    def _lit_colors(self, lighting: Lighting, origin: np.ndarray) -> np.ndarray:
+        """Each triangle's colour times ``ambient + diffuse * max(0, n . l)`` seen from
+        ``origin`` (before textures), ``n`` turned towards the camera."""
         light = np.asarray(lighting.direction, np.float64)
-        lambert = np.abs(self._normals @ (light / np.linalg.norm(light)))
+        towards = np.einsum("ij,ij->i", self._normals, origin - self._tris[:, 0])
+        lambert = np.maximum(self._normals @ (light / np.linalg.norm(light))
+                             * np.sign(towards), 0.0)
         return self.mesh.colors * (lighting.ambient + lighting.diffuse * lambert)[:, None]
 
     def _image(self, pose, camera_height: float, rays, k: int,
@@ -98,13 +105,15 @@ class RayCaster:
         H, W = tan_elev.shape
         hit = np.empty((H, W), np.int64)
         weights = np.empty((H, W, 3))
-        cast_columns(self._tris, np.array([x, y, camera_height]), yaw, beta, tan_elev,
+        origin = np.array([x, y, camera_height])
+        cast_columns(self._tris, self._normals, self._closed, origin, yaw, beta, tan_elev,
                      hit, weights)
         colors = np.empty((H, W, 3))
-        shade(hit, weights, self._lit_colors(lighting or DEFAULT_LIGHTING), self._texture,
+        shade(hit, weights, self._lit_colors(lighting or DEFAULT_LIGHTING, origin), self._texture,
               self._uvs, self._atlas, self._tex_shape, self.sky, colors)
-        if k > 1:
-            colors = colors.reshape(H // k, k, W // k, k, 3).mean(axis=(1, 3))
+        if k > 1:   # the mean of each pixel's k x k samples (INTER_AREA: box average)
+            colors = cv2.resize(colors.astype(np.float32), (W // k, H // k),
+                                interpolation=cv2.INTER_AREA)
         return photometric((colors * 255 + 0.5).astype(np.uint8), lighting)
 
     def panorama(self, pose, camera_height: float, config: CameraConfig,

@@ -7,7 +7,9 @@ whose front face carries the texture once). Each triangle has a colour (RGB in
 ``[0, 1]``), a texture index (``-1``: none) and texture coordinates per corner: ``u``
 left to right, ``v`` bottom to top, each box side and the floor covered by its texture
 once, a cylinder's side wrapped once around. The texture colour is multiplied by the
-body colour, as PyBullet does.
+body colour, as PyBullet does. The triangles of closed solids (boxes, prisms) are wound
+counter-clockwise seen from outside and marked ``closed``: from outside a solid, its
+faces turned away are hidden behind its other faces, so the renderer skips them.
 """
 
 from __future__ import annotations
@@ -31,17 +33,21 @@ FLOOR_MARGIN = 2.0
 class WorldMesh:
     """``triangles`` ``(N, 3, 3)`` float32 corners (metres); ``colors`` ``(N, 3)``;
     ``texture`` ``(N,)`` index into ``textures`` or ``-1``; ``uvs`` ``(N, 3, 2)``;
-    ``textures``: float32 RGB images in ``[0, 1]``, row 0 at the top."""
+    ``textures``: float32 RGB images in ``[0, 1]``, row 0 at the top; ``closed`` ``(N,)``
+    bool: part of a closed solid, wound counter-clockwise seen from outside (then the
+    normal points out)."""
 
     triangles: np.ndarray
     colors: np.ndarray
     texture: np.ndarray
     uvs: np.ndarray
     textures: list[np.ndarray]
+    closed: np.ndarray
 
     @property
     def normals(self) -> np.ndarray:
-        """Unit face normals ``(N, 3)`` (orientation arbitrary; shading is two-sided)."""
+        """Unit face normals ``(N, 3)`` (right-handed in corner order: outward on closed
+        solids, arbitrary elsewhere; shading is two-sided)."""
         n = np.cross(self.triangles[:, 1] - self.triangles[:, 0],
                      self.triangles[:, 2] - self.triangles[:, 0])
         return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
@@ -56,6 +62,7 @@ class _Builder:
         self.tex: list[int] = []
         self.uvs: list[np.ndarray] = []
         self.textures: list[np.ndarray] = []
+        self.closed: list[bool] = []
         self._texture_ids: dict[str, int] = {}
 
     def texture_id(self, name: str | None) -> int:
@@ -66,14 +73,26 @@ class _Builder:
             self.textures.append(load_texture(name).astype(np.float32) / 255.0)
         return self._texture_ids[name]
 
-    def quad(self, corners, uv, color, tex: int) -> None:
-        """Corners in order around the quad (any winding); ``uv`` per corner."""
+    def triangle(self, corners, uv, color, tex: int, inside=None) -> None:
+        """One triangle; ``inside``: a point inside the closed solid it bounds (the
+        triangle is then wound counter-clockwise seen from outside), or None."""
+        c, t = np.asarray(corners, np.float64), np.asarray(uv, np.float64)
+        if inside is not None:
+            normal = np.cross(c[1] - c[0], c[2] - c[0])
+            if normal @ (c.mean(axis=0) - np.asarray(inside, np.float64)) < 0:
+                c, t = c[[0, 2, 1]], t[[0, 2, 1]]
+        self.tris.append(c)
+        self.uvs.append(t)
+        self.colors.append(np.asarray(color[:3], np.float64))
+        self.tex.append(tex)
+        self.closed.append(inside is not None)
+
+    def quad(self, corners, uv, color, tex: int, inside=None) -> None:
+        """Corners in order around the quad; ``uv`` per corner; ``inside`` as in
+        :meth:`triangle`."""
         c, t = np.asarray(corners, np.float64), np.asarray(uv, np.float64)
         for i, j, k in ((0, 1, 2), (0, 2, 3)):
-            self.tris.append(c[[i, j, k]])
-            self.uvs.append(t[[i, j, k]])
-            self.colors.append(np.asarray(color[:3], np.float64))
-            self.tex.append(tex)
+            self.triangle(c[[i, j, k]], t[[i, j, k]], color, tex, inside)
 
     def box(self, centre, half, yaw: float, color, tex: int, front_only_uv: bool = False) -> None:
         """A box; every side textured once (``front_only_uv``: only the local +y side,
@@ -97,7 +116,7 @@ class _Builder:
         full = [(0, 0), (1, 0), (1, 1), (0, 1)]
         for name, corners in sides.items():
             uv = full if (not front_only_uv or name == "+y") else corner_uv
-            self.quad([world(p) for p in corners], uv, color, tex)
+            self.quad([world(p) for p in corners], uv, color, tex, inside=centre)
 
     def cylinder(self, centre, radius: float, height: float, yaw: float, color,
                  tex: int) -> None:
@@ -108,19 +127,16 @@ class _Builder:
         for k in range(CYLINDER_SIDES):
             self.quad([(x[k], y[k], z0), (x[k + 1], y[k + 1], z0), (x[k + 1], y[k + 1], z1),
                        (x[k], y[k], z1)], [(u[k], 0), (u[k + 1], 0), (u[k + 1], 1), (u[k], 1)],
-                      color, tex)
+                      color, tex, inside=centre)
             for z in (z0, z1):
-                tri = np.array([(centre[0], centre[1], z), (x[k], y[k], z),
-                                (x[k + 1], y[k + 1], z)])
-                self.tris.append(tri)
-                self.uvs.append(np.full((3, 2), 0.001))
-                self.colors.append(np.asarray(color[:3], np.float64))
-                self.tex.append(tex)
+                self.triangle([(centre[0], centre[1], z), (x[k], y[k], z),
+                               (x[k + 1], y[k + 1], z)], np.full((3, 2), 0.001), color, tex,
+                              inside=centre)
 
     def mesh(self) -> WorldMesh:
         return WorldMesh(np.array(self.tris, np.float32), np.array(self.colors, np.float32),
                          np.array(self.tex, np.int32), np.array(self.uvs, np.float32),
-                         self.textures)
+                         self.textures, np.array(self.closed, bool))
 
 
 def _landmark(b: _Builder, lm: Landmark) -> None:

@@ -370,7 +370,13 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
     torch.set_num_threads(config.torch_threads)
     # a bad env setting fails here, once, with its own message, before the run folder is
     # written (in a subprocess worker it would surface as a broken pipe)
-    make_env(config.env_id, config.env_kwargs).close()
+    probe = make_env(config.env_id, config.env_kwargs)
+    # the renderer and physics in effect are recorded, so that the policy is evaluated
+    # with them (homing_train.learning.ship) even after a default changes
+    made = probe.unwrapped
+    config.env_kwargs.setdefault("renderer", made.camera.config.renderer)
+    config.env_kwargs.setdefault("physics_substeps", made.physics_substeps)
+    probe.close()
     out.mkdir(parents=True, exist_ok=True)
     (out / "config.yml").write_text(yaml.safe_dump(asdict(config), sort_keys=False))
     with open(out / "command.txt", "a") as f:
