@@ -10,6 +10,11 @@ configuration, in the same run:
 * ``vector``: env steps per second summed over a ``gymnasium.vector.AsyncVectorEnv`` of
   ``--workers`` processes;
 * ``ratio``: time per env step divided by time per render (1.25 = the env adds 25%).
+
+Worlds: ``arena`` (Yu & Kim's arena, 1,074 triangles) and ``forest10k`` (40 trees as
+64-sided prisms of random size in a walled 10 m square, 10,290 triangles). With
+``tiny`` at 48 x 256 in the arena, the previous default (TinyRenderer with physics steps of
+1/240 s) is measured too.
 """
 
 from __future__ import annotations
@@ -25,15 +30,47 @@ from tqdm import tqdm
 
 import homing_gym  # noqa: F401  (registers the envs)
 from homing_gym.cli import command_parser
+from homing_gym.scenes import Landmark, Scene, square_walls
 
 #: Panorama shapes measured, (H, W) pixels.
 SHAPES = {"48x256": (48, 256), "60x360": (60, 360), "120x720": (120, 720)}
 
 
-def configs(renderers: list[str], shapes: list[str]) -> dict[str, dict]:
-    """Env kwargs of each measured configuration, named ``RENDERER HxW``."""
-    return {f"{r} {s}": {"renderer": r, "panorama_shape": SHAPES[s]}
-            for s in shapes for r in renderers}
+def forest_scene(trees: int = 40, seed: int = 0) -> Scene:
+    """A walled 10 m square with ``trees`` cylinders of random radius (0.1-0.4 m), height
+    (1-4 m) and colour, at least 1 m from the centre (the robot's start)."""
+    rng = np.random.default_rng(seed)
+    landmarks = []
+    while len(landmarks) < trees:
+        x, y = rng.uniform(-4.5, 4.5, 2)
+        if np.hypot(x, y) > 1.0:
+            landmarks.append(Landmark((float(x), float(y)), radius=float(rng.uniform(0.1, 0.4)),
+                                      height=float(rng.uniform(1, 4)),
+                                      color=(*rng.uniform(0.1, 0.9, 3).tolist(), 1.0)))
+    return Scene("forest10k", ((-5, -5), (5, 5)), walls=square_walls(10.0),
+                 landmarks=tuple(landmarks))
+
+
+#: Worlds measured: scene kwargs.
+WORLDS = {"arena": {}, "forest10k": {"scene": forest_scene()}}
+
+
+def configs(renderers: list[str], shapes: list[str],
+            worlds: list[str] = ("arena",)) -> dict[str, dict]:
+    """Env kwargs of each measured configuration, named ``RENDERER HxW [WORLD]``; with
+    ``tiny`` at 48 x 256 in the arena also ``tiny 48x256 1/240 s`` (the previous default:
+    physics steps of 1/240 s)."""
+    out = {}
+    for world in worlds:
+        suffix = "" if world == "arena" else f" {world}"
+        for s in shapes:
+            for r in renderers:
+                out[f"{r} {s}{suffix}"] = {"renderer": r, "panorama_shape": SHAPES[s],
+                                           **WORLDS[world]}
+                if (r, s, world) == ("tiny", "48x256", "arena"):
+                    out["tiny 48x256 1/240 s"] = {"renderer": r, "panorama_shape": SHAPES[s],
+                                                  "physics_substeps": 24}
+    return out
 
 
 @dataclass
@@ -105,12 +142,15 @@ def run_config(name: str, env_kwargs: dict, steps: int, workers: int, rounds: in
 def format_table(results: list[BenchmarkResult]) -> str:
     """A Markdown table of the results; ``env vs tiny``: env steps/s over those of
     ``renderer="tiny"`` at the same shape in the same run."""
-    tiny = {tuple(r.env_kwargs["panorama_shape"]): r.env_steps_per_s for r in results
-            if r.env_kwargs.get("renderer") == "tiny"}
+    def key(r: BenchmarkResult) -> tuple:
+        return (tuple(r.env_kwargs["panorama_shape"]), str(r.env_kwargs.get("scene")),
+                r.env_kwargs.get("physics_substeps"))
+
+    tiny = {key(r): r.env_steps_per_s for r in results if r.env_kwargs.get("renderer") == "tiny"}
     lines = ["| config | render (pano/s) | env (steps/s) | env vs tiny | env / render time | "
              "AsyncVectorEnv (steps/s) |", "|---|---|---|---|---|---|"]
     for r in results:
-        ref = tiny.get(tuple(r.env_kwargs["panorama_shape"]))
+        ref = tiny.get(key(r))
         versus = f"{r.env_steps_per_s / ref:.2f}x" if ref else "-"
         lines.append(f"| {r.config} | {r.render_per_s:.1f} | {r.env_steps_per_s:.1f} | "
                      f"{versus} | {r.ratio:.3f} | {r.vector_steps_per_s:.1f} "
@@ -126,16 +166,19 @@ def main(argv: list[str] | None = None) -> int:
                         choices=["tiny", "raycast", "egl"], help="renderers to compare")
     parser.add_argument("--shapes", nargs="+", default=list(SHAPES), choices=list(SHAPES),
                         help="panorama shapes (H x W)")
+    parser.add_argument("--worlds", nargs="+", default=["arena"], choices=list(WORLDS),
+                        help="worlds (forest10k: 10,290 triangles)")
     parser.add_argument("--json", help="also write the results to this JSON file")
     args = parser.parse_args(argv)
     if args.steps < 10 or args.workers < 1:
         parser.error("need --steps >= 10 and --workers >= 1")
     results = [run_config(name, kwargs, args.steps, args.workers)
-               for name, kwargs in configs(args.renderers, args.shapes).items()]
+               for name, kwargs in configs(args.renderers, args.shapes, args.worlds).items()]
     print(format_table(results))
     if args.json:
         with open(args.json, "w") as f:
-            json.dump([asdict(r) | {"ratio": r.ratio} for r in results], f, indent=2)
+            json.dump([asdict(r) | {"ratio": r.ratio} for r in results], f, indent=2,
+                      default=lambda scene: scene.name)
     return 0
 
 

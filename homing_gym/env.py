@@ -65,6 +65,7 @@ class HomingEnv(gym.Env):
                  vfov_deg: float = math.degrees(CameraConfig.vfov),
                  n_views: int = CameraConfig.n_views, renderer: str = CameraConfig.renderer,
                  omni_size: int = CameraConfig.omni_size,
+                 supersampling: int = CameraConfig.supersampling,
                  action_type: str = "continuous", control_period: float = 0.1,
                  physics_substeps: int | None = None, max_speed: float = RobotConfig.max_speed,
                  max_yaw_rate: float = RobotConfig.max_yaw_rate, stop_threshold: float = 0.05,
@@ -127,6 +128,9 @@ class HomingEnv(gym.Env):
         if not (isinstance(camera_height, (int, float)) and 0.005 <= camera_height <= 5.0):
             raise ValueError(f"camera_height must be in [0.005, 5] metres above the floor, "
                              f"got {camera_height!r}")
+        if supersampling != CameraConfig.supersampling and renderer != "raycast":
+            raise ValueError(f"supersampling needs renderer='raycast', got "
+                             f"renderer={renderer!r}")
         if sky_color is not None:
             if renderer != "raycast":
                 raise ValueError(f"sky_color needs renderer='raycast' (the {renderer!r} "
@@ -146,7 +150,8 @@ class HomingEnv(gym.Env):
                                         camera_height=float(camera_height), drive=drive)
         camera_config = CameraConfig(
             panorama_shape=tuple(panorama_shape), vfov=math.radians(vfov_deg),
-            n_views=n_views, omni_size=omni_size, renderer=renderer)
+            n_views=n_views, omni_size=omni_size, renderer=renderer,
+            supersampling=supersampling)
         self.odometry = odometry_for(self.robot_config, odometry_noise)
         self.odometry_origin = odometry_origin
         self._scene_factory = scene_factory(scene)

@@ -105,7 +105,8 @@ class LocalHomingEnv(HomingEnv):
     ``"human"``: PyBullet GUI), ``obs_keys``, ``panorama_shape`` = (48, 256),
     ``vfov_deg`` = 60, ``n_views`` = 6, ``renderer`` = ``"raycast"`` (exact ray casting,
     one ray per pixel centre, see :mod:`homing_gym.raycast`; ``"tiny"``: PyBullet's
-    TinyRenderer, six perspective views remapped; ``"egl"``: PyBullet's OpenGL plugin), ``omni_size`` = 128,
+    TinyRenderer, six perspective views remapped; ``"egl"``: PyBullet's OpenGL plugin),
+    ``supersampling`` = 2 (raycast: ``k x k`` rays averaged per panorama pixel, 1-4), ``omni_size`` = 128,
     ``action_type``, ``control_period`` (at most 2 s), ``physics_substeps`` (1-1000; each
     physics step between 1/2000 and 1/60 s), ``max_speed``,
     ``max_yaw_rate``, ``stop_threshold``, ``odometry_noise`` = 0.02,

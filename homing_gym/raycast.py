@@ -13,7 +13,9 @@ one, times ``ambient + diffuse * max(0, n . l)`` (Lambert with the
 side the camera sees: a face turned away from the light gets the ambient term alone, as
 in TinyRenderer, so walls of different orientation differ in brightness), clipped, then
 the lighting's brightness/contrast change; rays that hit nothing see ``sky_color``. With
-``supersampling = k`` each pixel averages ``k x k`` rays spread evenly over its area. The
+``supersampling = k`` each pixel averages ``k x k`` rays spread evenly over its area
+(panoramas: ``CameraConfig.supersampling``, perspective views:
+:data:`~homing_gym.perspective.VIEW_SUPERSAMPLING`). The
 robot's own body is not part of the world mesh, so it never occludes the camera. The
 same pose gives the same pixels.
 
@@ -117,10 +119,12 @@ class RayCaster:
         return photometric((colors * 255 + 0.5).astype(np.uint8), lighting)
 
     def panorama(self, pose, camera_height: float, config: CameraConfig,
-                 lighting: Lighting | None = None, supersampling: int = 1) -> np.ndarray:
-        """The cylindrical panorama (uint8 ``(H, W, 3)``) at ``pose = (x, y, yaw)``."""
-        rays = panorama_rays(tuple(config.panorama_shape), config.vfov, supersampling)
-        return self._image(pose, camera_height, rays, supersampling, lighting)
+                 lighting: Lighting | None = None, supersampling: int | None = None) -> np.ndarray:
+        """The cylindrical panorama (uint8 ``(H, W, 3)``) at ``pose = (x, y, yaw)``;
+        ``supersampling`` defaults to ``config.supersampling``."""
+        k = config.supersampling if supersampling is None else supersampling
+        rays = panorama_rays(tuple(config.panorama_shape), config.vfov, k)
+        return self._image(pose, camera_height, rays, k, lighting)
 
     def perspective(self, pose, camera_height: float, width: int, height: int, focal: float,
                     lighting: Lighting | None = None, supersampling: int = 1) -> np.ndarray:
