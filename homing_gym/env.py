@@ -40,10 +40,6 @@ ODOMETRY_ORIGINS = ("start", "home")
 #: through walls, shorter ones only cost time).
 MAX_SUBSTEPS, MAX_CONTROL_PERIOD = 1000, 2.0
 MIN_TIME_STEP, MAX_TIME_STEP = 1 / 2000, 1 / 60
-#: Physics steps per second when ``physics_substeps`` is not given (1/120 s steps: the
-#: motion tests hold; 1/240 s cost twice as much for 1-2 % less difference in motion,
-#: and 1/80 s lost 11 % of the forward speed, docs/benchmark.md).
-PHYSICS_RATE = 120
 #: Observation keys the env core provides (tasks may add more): see
 #: :mod:`homing_gym.observations`.
 OBSERVATION_KEYS = (*CORE_KEYS, "goal_step")
@@ -67,7 +63,7 @@ class HomingEnv(gym.Env):
                  omni_size: int = CameraConfig.omni_size,
                  supersampling: int = CameraConfig.supersampling,
                  action_type: str = "continuous", control_period: float = 0.1,
-                 physics_substeps: int | None = None, max_speed: float = RobotConfig.max_speed,
+                 physics_substeps: int = 24, max_speed: float = RobotConfig.max_speed,
                  max_yaw_rate: float = RobotConfig.max_yaw_rate, stop_threshold: float = 0.05,
                  odometry_noise: float = 0.02, odometry_origin: str = "start",
                  lighting_change: float = 0.0, goal_step_length: float = 0.15,
@@ -88,8 +84,6 @@ class HomingEnv(gym.Env):
         if control_period > MAX_CONTROL_PERIOD:
             raise ValueError(f"control_period must be at most {MAX_CONTROL_PERIOD} s, "
                              f"got {control_period!r}")
-        if physics_substeps is None:
-            physics_substeps = max(1, math.ceil(control_period * PHYSICS_RATE - 1e-9))
         if not (isinstance(physics_substeps, (int, np.integer))
                 and 1 <= physics_substeps <= MAX_SUBSTEPS):
             raise ValueError(f"physics_substeps must be an integer in [1, {MAX_SUBSTEPS}], "

@@ -83,7 +83,7 @@ class CameraConfig:
     far: float = 30.0
     omni_size: int = 128
     signature_rows: int = 5
-    renderer: str = "raycast"
+    renderer: str = "tiny"
     supersampling: int = 2
 
     def __post_init__(self) -> None:

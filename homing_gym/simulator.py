@@ -38,7 +38,7 @@ class Simulator:
     """One PyBullet client holding a scene and the robot."""
 
     def __init__(self, scene: Scene, *, gui: bool = False, time_step: float = 1 / 240,
-                 robot_config: RobotConfig = RobotConfig(), renderer: str = "raycast",
+                 robot_config: RobotConfig = RobotConfig(), renderer: str = "tiny",
                  sky_color: tuple[float, float, float] | None = None):
         with native_output_captured():    # the C++ core prints "argv[0]=" on connecting
             self.client = BulletClient(connection_mode=p.GUI if gui else p.DIRECT)
