@@ -20,6 +20,7 @@ from homing_gym.actions import DiscreteAction
 from homing_gym.geometry import to_frame
 from homing_gym.observations import CORE_KEYS, ObservationKey, Sight, goal_step_key
 from homing_gym.panorama import CameraConfig, Lighting, PanoramaCamera, random_lighting
+from homing_gym.paths import occupancy
 from homing_gym.perspective import PerspectiveConfig, render_perspective
 from homing_gym.robot import RobotConfig, odometry_for
 from homing_gym.scenes import scene_factory
@@ -43,6 +44,16 @@ MIN_TIME_STEP, MAX_TIME_STEP = 1 / 2000, 1 / 60
 #: Observation keys the env core provides (tasks may add more): see
 #: :mod:`homing_gym.observations`.
 OBSERVATION_KEYS = (*CORE_KEYS, "goal_step")
+#: Grid (metres) on which a new world is checked for room for the robot.
+ROOM_RESOLUTION = 0.05
+
+
+def _check_room(scene: Scene, radius: float) -> None:
+    """Refuse a world in which the robot (a disc of ``radius`` metres) fits nowhere."""
+    if not occupancy(scene, radius, ROOM_RESOLUTION)[0].any():
+        raise ValueError(f"scene {scene.name!r} has no free space for the robot (a disc of "
+                         f"radius {radius} m) within its bounds {scene.bounds!r} at the "
+                         f"robot's height ({scene.height_band[0]}-{scene.height_band[1]} m)")
 
 
 class HomingEnv(gym.Env):
@@ -150,6 +161,7 @@ class HomingEnv(gym.Env):
         self.odometry_origin = odometry_origin
         self._scene_factory = scene_factory(scene)
         self.scene = self._scene_factory.build(np.random.default_rng(0))
+        _check_room(self.scene, self.robot_config.body_radius)
         task.check_scene(self.scene)
         self.sim = Simulator(self.scene, gui=render_mode == "human",
                              time_step=self.control_period / self.physics_substeps,

@@ -28,10 +28,19 @@ from homing_gym.native_output import native_output_captured
 from homing_gym.raycast import SKY_COLOR, RayCaster
 from homing_gym.robot import Robot, RobotConfig
 from homing_gym.scenes.base import Landmark, Scene, Wall
+from homing_gym.scenes.footprint import band_faces
+from homing_gym.scenes.mesh_part import MeshPart
 from homing_gym.textures import texture_path
-from homing_gym.worldmesh import world_mesh
+from homing_gym.worldmesh import FLOOR_MARGIN, floor_top, world_mesh
 
-FLOOR_MARGIN = 2.0
+FENCE_THICKNESS = 0.1
+
+
+def _fixed_part(scene: Scene) -> tuple:
+    """What a randomised scene may not change without a rebuild: the floor, the walls'
+    geometry and the fence."""
+    return (scene.bounds, scene.ground_plane, scene.fence,
+            tuple((w.start, w.end, w.height, w.thickness) for w in scene.walls))
 
 
 class Simulator:
@@ -46,29 +55,45 @@ class Simulator:
         c = self.client
         # the EGL plugin only sees bodies created after it is loaded: load it first
         self.renderer = load_egl(c) if renderer == "egl" else p.ER_TINY_RENDERER
+        self._sky_color = sky_color
         #: The ray caster of the current world (``renderer="raycast"``), else None.
-        self.sky_color = SKY_COLOR if sky_color is None else tuple(sky_color)
-        self.caster = (RayCaster(world_mesh(scene), self.sky_color) if renderer == "raycast"
+        self.caster = (RayCaster(world_mesh(scene), self.sky(scene)) if renderer == "raycast"
                        else None)
-        c.setGravity(0, 0, -9.81)
-        c.setTimeStep(time_step)
-        c.setPhysicsEngineParameter(deterministicOverlappingPairs=1, numSolverIterations=10)
-        if gui:
-            c.configureDebugVisualizer(p.COV_ENABLE_GUI, 0)
         self.time_step = time_step
+        self._gui = gui
+        self._robot_config = robot_config
         self._step_simulation = c.stepSimulation      # BulletClient builds a new partial on
         self._contact_points = c.getContactPoints     # every attribute access: keep these
+        self._build(scene)
+
+    # -- building -------------------------------------------------------------------------
+    def _build(self, scene: Scene) -> None:
+        """Make the whole world in an empty client: floor, walls, fence, robot (state
+        saved bare), then landmarks and mesh parts (state saved)."""
+        c = self.client
+        c.setGravity(0, 0, -9.81)
+        c.setTimeStep(self.time_step)
+        c.setPhysicsEngineParameter(deterministicOverlappingPairs=1, numSolverIterations=10)
+        if self._gui:
+            c.configureDebugVisualizer(p.COV_ENABLE_GUI, 0)
         self._textures: dict[str, int] = {}
         self.scene = scene
         self.floor_id = self._make_floor(scene)
         self.wall_ids = [self._make_wall(w) for w in scene.walls]
-        self.robot = Robot(c, robot_config)
+        self.fence_ids = self._make_fence(scene) if scene.fence else []
+        self.robot = Robot(c, self._robot_config)
         self._bare_state = c.saveState()
-        self.landmark_ids = [self._make_landmark(lm) for lm in scene.landmarks]
-        self._state = c.saveState()
-        self.obstacle_ids = frozenset(self.wall_ids + self.landmark_ids)
+        self._make_objects(scene)
 
-    # -- building -------------------------------------------------------------------------
+    def _make_objects(self, scene: Scene) -> None:
+        """The landmarks and mesh parts of ``scene``; saves the state."""
+        self.landmark_ids = [self._make_landmark(lm) for lm in scene.landmarks]
+        self.mesh_ids = [body for part in scene.meshes
+                         for body in self._make_part(part, scene.height_band)]
+        self._state = self.client.saveState()
+        self.obstacle_ids = frozenset(self.wall_ids + self.fence_ids + self.landmark_ids
+                                      + self.mesh_ids)
+
     def _texture(self, name: str | None) -> int | None:
         if name is None:
             return None
@@ -92,13 +117,15 @@ class Simulator:
     def _make_floor(self, scene: Scene) -> int:
         (xmin, ymin), (xmax, ymax) = scene.bounds
         half = [(xmax - xmin) / 2 + FLOOR_MARGIN, (ymax - ymin) / 2 + FLOOR_MARGIN, 0.05]
-        centre = [(xmin + xmax) / 2, (ymin + ymax) / 2, -0.05]
+        centre = [(xmin + xmax) / 2, (ymin + ymax) / 2, floor_top(scene) - 0.05]
         c = self.client
         col = c.createCollisionShape(p.GEOM_PLANE)
-        vis = c.createVisualShape(p.GEOM_BOX, halfExtents=half, visualFramePosition=centre,
-                                  rgbaColor=list(scene.floor_color))
+        vis = (c.createVisualShape(p.GEOM_BOX, halfExtents=half, visualFramePosition=centre,
+                                   rgbaColor=list(scene.floor_color))
+               if scene.ground_plane else -1)
         body = c.createMultiBody(0, col, vis, [0, 0, 0])
-        self._paint(body, scene.floor_color, scene.floor_texture)
+        if scene.ground_plane:
+            self._paint(body, scene.floor_color, scene.floor_texture)
         c.changeDynamics(body, -1, lateralFriction=1.0)
         return body
 
@@ -108,6 +135,42 @@ class Simulator:
         yaw = math.atan2(y1 - y0, x1 - x0)
         return self._box(half, [(x0 + x1) / 2, (y0 + y1) / 2, wall.height / 2], yaw,
                          wall.color, wall.texture)
+
+    def _make_fence(self, scene: Scene) -> list[int]:
+        """Four invisible walls just outside ``scene.bounds`` (1 m high, 0.1 m thick)."""
+        (xmin, ymin), (xmax, ymax) = scene.bounds
+        t, c = FENCE_THICKNESS, self.client
+        cx, cy, hx, hy = (xmin + xmax) / 2, (ymin + ymax) / 2, (xmax - xmin) / 2, (ymax - ymin) / 2
+        boxes = (((cx, ymin - t / 2), (hx + t, t / 2)), ((cx, ymax + t / 2), (hx + t, t / 2)),
+                 ((xmin - t / 2, cy), (t / 2, hy + t)), ((xmax + t / 2, cy), (t / 2, hy + t)))
+        return [c.createMultiBody(0, c.createCollisionShape(p.GEOM_BOX,
+                                                            halfExtents=[*half, 0.5]),
+                                  -1, [*centre, 0.5])
+                for centre, half in boxes]
+
+    def _make_part(self, part: MeshPart, band: tuple[float, float]) -> list[int]:
+        """Bodies of a mesh part: one static concave collision body of its triangles that
+        reach into ``band`` (if it collides and any do), and, for PyBullet's renderers,
+        one visual body (no collision) per face colour (colours rounded to 1/16: a
+        PyBullet mesh takes one colour)."""
+        c, bodies = self.client, []
+        faces = part.faces[band_faces(part, band)] if part.collision else part.faces[:0]
+        if len(faces):
+            col = c.createCollisionShape(p.GEOM_MESH, vertices=part.vertices.tolist(),
+                                         indices=faces.ravel().tolist(),
+                                         flags=p.GEOM_FORCE_CONCAVE_TRIMESH)
+            bodies.append(c.createMultiBody(0, col, -1, [0, 0, 0]))
+        if self.caster is None:
+            levels = np.round(part.face_colors * 16).astype(np.int64)
+            keys = (levels[:, 0] * 17 + levels[:, 1]) * 17 + levels[:, 2]
+            for key in np.unique(keys):
+                group = part.faces[keys == key]
+                vis = c.createVisualShape(
+                    p.GEOM_MESH, vertices=part.vertices.tolist(),
+                    indices=group.ravel().tolist(),
+                    rgbaColor=[*(levels[keys == key][0] / 16), 1.0])
+                bodies.append(c.createMultiBody(0, -1, vis, [0, 0, 0]))
+        return bodies
 
     def _make_landmark(self, lm: Landmark) -> int:
         position = [lm.position[0], lm.position[1], lm.base + lm.height / 2]
@@ -163,31 +226,34 @@ class Simulator:
 
     # -- episodes -------------------------------------------------------------------------
     def reset_world(self, scene: Scene) -> None:
-        """Bring the world back to its saved state, switching to ``scene`` if it differs.
-
-        ``scene`` must have the same walls' geometry as the one the simulator was built
-        with (randomised scenes change landmarks and textures only).
-        """
+        """Bring the world back to its saved state, switching to ``scene`` if it differs:
+        a scene with the same floor, walls and fence (a randomised scene that changes its
+        landmarks, meshes and colours) rebuilds only those; any other is built anew in an
+        emptied client."""
         c = self.client
         if scene == self.scene:
             c.restoreState(self._state)
             return
-        if len(scene.walls) != len(self.wall_ids):
-            raise ValueError(f"scene {scene.name!r} has {len(scene.walls)} walls; this "
-                             f"simulator was built with {len(self.wall_ids)}")
-        for body in self.landmark_ids:
-            c.removeBody(body)
-        c.removeState(self._state)
-        c.restoreState(self._bare_state)
-        for body, wall in zip(self.wall_ids, scene.walls):
-            self._paint(body, wall.color, wall.texture)
-        self._paint(self.floor_id, scene.floor_color, scene.floor_texture)
-        self.landmark_ids = [self._make_landmark(lm) for lm in scene.landmarks]
-        self._state = c.saveState()
-        self.obstacle_ids = frozenset(self.wall_ids + self.landmark_ids)
-        self.scene = scene
+        if _fixed_part(scene) != _fixed_part(self.scene):
+            c.resetSimulation()
+            self._build(scene)
+        else:
+            for body in self.landmark_ids + self.mesh_ids:
+                c.removeBody(body)
+            c.removeState(self._state)
+            c.restoreState(self._bare_state)
+            for body, wall in zip(self.wall_ids, scene.walls):
+                self._paint(body, wall.color, wall.texture)
+            if scene.ground_plane:
+                self._paint(self.floor_id, scene.floor_color, scene.floor_texture)
+            self.scene = scene
+            self._make_objects(scene)
         if self.caster is not None:
-            self.caster = RayCaster(world_mesh(scene), self.sky_color)
+            self.caster = RayCaster(world_mesh(scene), self.sky(scene))
+
+    def sky(self, scene: Scene) -> tuple[float, float, float]:
+        """The ray caster's sky: the env's ``sky_color``, else the scene's, else white."""
+        return tuple(self._sky_color or scene.sky_color or SKY_COLOR)
 
     def place_robot(self, pose, clear_contacts: bool = False) -> None:
         """Teleport the robot to ``pose`` (x, y, yaw; metres, radians). With

@@ -8,6 +8,7 @@ import cv2
 import numpy as np
 
 from homing_gym.scenes.base import Scene
+from homing_gym.scenes.footprint import band_faces
 
 BG = (245, 245, 240)
 WALL = (60, 60, 60)
@@ -36,8 +37,10 @@ class MapCanvas:
 
 
 def draw_scene(scene: Scene, canvas: MapCanvas) -> np.ndarray:
-    """Walls and landmarks (in their own colours) on a light background, RGB uint8."""
+    """Mesh footprints, walls and landmarks (in their own colours) on a light background,
+    RGB uint8."""
     img = np.full((canvas.size, canvas.size, 3), BG, np.uint8)
+    _draw_meshes(img, scene, canvas)
     for wall in scene.walls:
         cv2.line(img, canvas.px(*wall.start), canvas.px(*wall.end), WALL,
                  canvas.length(wall.thickness), cv2.LINE_AA)
@@ -54,6 +57,28 @@ def draw_scene(scene: Scene, canvas: MapCanvas) -> np.ndarray:
             cv2.fillPoly(img, [np.array([canvas.px(*q) for q in corners], np.int32)], color,
                          cv2.LINE_AA)
     return img
+
+
+def _draw_meshes(img: np.ndarray, scene: Scene, canvas: MapCanvas) -> None:
+    """The faces of mesh parts that reach into the scene's height band, seen from above in
+    their colours (lower faces first; parts the robot passes through lighter)."""
+    faces, colors, tops = [], [], []
+    for part in scene.meshes:
+        index = band_faces(part, scene.height_band)
+        tris = part.triangles[index]
+        faces.append(tris[:, :, :2])
+        colors.append(part.face_colors[index] if part.collision
+                      else 0.5 + 0.5 * part.face_colors[index])
+        tops.append(tris[:, :, 2].max(axis=1))
+    if not faces:
+        return
+    order = np.argsort(np.concatenate(tops), kind="stable")
+    faces, colors = np.concatenate(faces)[order], np.concatenate(colors)[order]
+    for tri, color in zip(faces, colors):
+        pts = np.array([canvas.px(*q) for q in tri], np.int32)
+        bgr = tuple(int(255 * c) for c in color)
+        cv2.fillPoly(img, [pts], bgr, cv2.LINE_AA)
+        cv2.polylines(img, [pts], True, bgr, 1, cv2.LINE_AA)
 
 
 def draw_scale_bar(img: np.ndarray, canvas: MapCanvas, metres: float = 0.5) -> None:

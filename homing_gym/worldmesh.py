@@ -3,7 +3,8 @@
 :func:`world_mesh` turns a :class:`~homing_gym.scenes.base.Scene` into triangles with the
 same placement as the PyBullet bodies of :class:`~homing_gym.simulator.Simulator` (floor
 top face, walls and box landmarks as boxes, cylinders as 64-sided prisms, panels as boxes
-whose front face carries the texture once). Each triangle has a colour (RGB in
+whose front face carries the texture once, mesh parts as they are; a textured part's
+texture repeats outside ``[0, 1]`` uv). Each triangle has a colour (RGB in
 ``[0, 1]``), a texture index (``-1``: none) and texture coordinates per corner: ``u``
 left to right, ``v`` bottom to top, each box side and the floor covered by its texture
 once, a cylinder's side wrapped once around. The texture colour is multiplied by the
@@ -20,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from homing_gym.scenes.base import Landmark, Scene
+from homing_gym.scenes.mesh_part import MeshPart
 from homing_gym.textures import load_texture
 
 #: Sides of the prism that stands for a cylinder: the silhouette is within
@@ -27,6 +29,15 @@ from homing_gym.textures import load_texture
 CYLINDER_SIDES = 64
 #: Margin (metres) of the floor beyond the scene bounds, as in the simulator.
 FLOOR_MARGIN = 2.0
+#: How far (metres) the drawn floor lies below z = 0 in scenes with mesh parts, so that a
+#: mesh's own ground at z = 0 is drawn instead of flickering against it.
+MESH_FLOOR_DROP = 0.002
+
+
+def floor_top(scene: Scene) -> float:
+    """Height (metres) of the drawn floor's top face: 0, or :data:`MESH_FLOOR_DROP`
+    below 0 in a scene with mesh parts."""
+    return -MESH_FLOOR_DROP if scene.meshes else 0.0
 
 
 @dataclass
@@ -69,9 +80,13 @@ class _Builder:
         if name is None:
             return -1
         if name not in self._texture_ids:
-            self._texture_ids[name] = len(self.textures)
-            self.textures.append(load_texture(name).astype(np.float32) / 255.0)
+            self._texture_ids[name] = self.add_texture(load_texture(name))
         return self._texture_ids[name]
+
+    def add_texture(self, image: np.ndarray) -> int:
+        """Index of a new texture (uint8 RGB, row 0 at the top)."""
+        self.textures.append(image.astype(np.float32) / 255.0)
+        return len(self.textures) - 1
 
     def triangle(self, corners, uv, color, tex: int, inside=None) -> None:
         """One triangle; ``inside``: a point inside the closed solid it bounds (the
@@ -133,6 +148,21 @@ class _Builder:
                                (x[k + 1], y[k + 1], z)], np.full((3, 2), 0.001), color, tex,
                               inside=centre)
 
+    def part(self, part: MeshPart) -> None:
+        """A mesh part's faces, open (never skipped as back faces); a textured part shows
+        its texture alone (its face colours are the texture's, for TinyRenderer)."""
+        tris = part.triangles
+        self.tris.extend(tris)
+        self.closed.extend([False] * len(tris))
+        if part.texture is None:
+            self.colors.extend(part.face_colors)
+            self.tex.extend([-1] * len(tris))
+            self.uvs.extend(np.full((len(tris), 3, 2), 0.001))
+        else:
+            self.colors.extend(np.ones((len(tris), 3)))
+            self.tex.extend([self.add_texture(part.texture)] * len(tris))
+            self.uvs.extend(part.uvs[part.faces])
+
     def mesh(self) -> WorldMesh:
         return WorldMesh(np.array(self.tris, np.float32), np.array(self.colors, np.float32),
                          np.array(self.tex, np.int32), np.array(self.uvs, np.float32),
@@ -150,14 +180,17 @@ def _landmark(b: _Builder, lm: Landmark) -> None:
 
 
 def world_mesh(scene: Scene) -> WorldMesh:
-    """The triangles of ``scene``'s floor, walls and landmarks (see the module doc)."""
+    """The triangles of ``scene``'s floor (if ``ground_plane``), walls, landmarks and mesh
+    parts (see the module doc)."""
     b = _Builder()
     (xmin, ymin), (xmax, ymax) = scene.bounds
     x0, x1 = xmin - FLOOR_MARGIN, xmax + FLOOR_MARGIN
     y0, y1 = ymin - FLOOR_MARGIN, ymax + FLOOR_MARGIN
-    b.quad([(x0, y0, 0.0), (x1, y0, 0.0), (x1, y1, 0.0), (x0, y1, 0.0)],
-           [(0, 0), (1, 0), (1, 1), (0, 1)], scene.floor_color,
-           b.texture_id(scene.floor_texture))
+    if scene.ground_plane:
+        z = floor_top(scene)
+        b.quad([(x0, y0, z), (x1, y0, z), (x1, y1, z), (x0, y1, z)],
+               [(0, 0), (1, 0), (1, 1), (0, 1)], scene.floor_color,
+               b.texture_id(scene.floor_texture))
     for wall in scene.walls:
         (wx0, wy0), (wx1, wy1) = wall.start, wall.end
         b.box(((wx0 + wx1) / 2, (wy0 + wy1) / 2, wall.height / 2),
@@ -165,4 +198,6 @@ def world_mesh(scene: Scene) -> WorldMesh:
               math.atan2(wy1 - wy0, wx1 - wx0), wall.color, b.texture_id(wall.texture))
     for lm in scene.landmarks:
         _landmark(b, lm)
+    for part in scene.meshes:
+        b.part(part)
     return b.mesh()

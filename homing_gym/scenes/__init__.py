@@ -18,6 +18,8 @@ from homing_gym.scenes.corridors import corridors_scene
 from homing_gym.scenes.hallway import hallway_scene
 from homing_gym.scenes.house import house_scene
 from homing_gym.scenes.lab import lab_scene
+from homing_gym.scenes.mesh_part import MeshPart
+from homing_gym.scenes.mesh_scene import MeshScene, mesh_scene_from_spec
 from homing_gym.scenes.random_arena import random_arena_scene
 
 
@@ -32,6 +34,8 @@ class SceneFactory:
 
 
 _SCENES: dict[str, SceneFactory] = {}
+#: A scene string starting with this names a mesh file.
+MESH_PREFIX = "mesh:"
 
 
 def register_scene(name: str, factory: SceneFactory) -> None:
@@ -45,14 +49,18 @@ def available_scenes() -> list[str]:
 
 
 def scene_factory(scene: "str | Scene | SceneFactory") -> SceneFactory:
-    """The factory for a scene name, or a fixed factory around a :class:`Scene` object
-    (a :class:`SceneFactory` is returned as is)."""
+    """The factory for a scene name or a ``"mesh:PATH"`` string
+    (:mod:`homing_gym.scenes.mesh_scene`), or a fixed factory around a :class:`Scene`
+    object (a :class:`SceneFactory` is returned as is)."""
     if isinstance(scene, SceneFactory):
         return scene
     if isinstance(scene, Scene):
         return SceneFactory(build=lambda rng, s=scene: s, description=scene.name)
+    if isinstance(scene, str) and scene.startswith(MESH_PREFIX):
+        return scene_factory(mesh_scene_from_spec(scene))
     if scene not in _SCENES:
-        raise ValueError(f"unknown scene {scene!r}; allowed: {available_scenes()}")
+        raise ValueError(f"unknown scene {scene!r}; allowed: {available_scenes()}, or "
+                         f"'{MESH_PREFIX}PATH' for a mesh file")
     return _SCENES[scene]
 
 
@@ -78,5 +86,6 @@ register_scene("random_arena", SceneFactory(
     build=random_arena_scene, randomised=True,
     description="2.4 m square, 3-8 random landmarks and textures per episode"))
 
-__all__ = ["SHAPES", "Landmark", "Scene", "SceneFactory", "Wall", "available_scenes",
-           "register_scene", "scene_factory", "square_walls"]
+__all__ = ["MESH_PREFIX", "SHAPES", "Landmark", "MeshPart", "MeshScene", "Scene",
+           "SceneFactory", "Wall", "available_scenes", "register_scene", "scene_factory",
+           "square_walls"]

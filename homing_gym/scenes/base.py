@@ -14,6 +14,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from homing_gym.scenes.footprint import mesh_clearances
+from homing_gym.scenes.mesh_part import MeshPart
 from homing_gym.textures import check_texture
 from homing_gym.validation import require_positive
 
@@ -113,10 +115,21 @@ class Wall:
         return math.dist(self.start, self.end)
 
 
+#: Heights (metres above the floor) in which mesh parts block the robot: above floor-level
+#: detail, up to just over the camera (:mod:`homing_gym.scenes.footprint`).
+HEIGHT_BAND = (0.02, 0.35)
+
+
 @dataclass(frozen=True)
 class Scene:
-    """A world: the free floor area ``bounds`` = ((xmin, ymin), (xmax, ymax)), walls and
-    landmarks. Every landmark must lie inside ``bounds``; the robot is placed inside them."""
+    """A world: the free floor area ``bounds`` = ((xmin, ymin), (xmax, ymax)), walls,
+    landmarks and triangle ``meshes`` (:class:`MeshPart`, e.g. from a mesh file: see
+    :class:`~homing_gym.scenes.mesh_scene.MeshScene`). Every landmark must lie inside
+    ``bounds``; the robot is placed inside them, and with ``fence`` invisible walls along
+    them keep it there (for worlds without walls). ``ground_plane``: draw the floor
+    (``floor_color``/``floor_texture``; the robot always drives on the plane z = 0).
+    ``sky_color``: RGB in [0, 1] that the ray caster shows where rays hit nothing (the
+    env's ``sky_color`` argument overrides it). ``height_band``: see :data:`HEIGHT_BAND`."""
 
     name: str
     bounds: tuple[tuple[float, float], tuple[float, float]]
@@ -124,12 +137,27 @@ class Scene:
     landmarks: tuple[Landmark, ...] = ()
     floor_color: Color = (0.55, 0.55, 0.55, 1.0)
     floor_texture: str | None = None
+    meshes: tuple[MeshPart, ...] = ()
+    fence: bool = False
+    ground_plane: bool = True
+    sky_color: tuple[float, float, float] | None = None
+    height_band: tuple[float, float] = HEIGHT_BAND
     metadata: dict = field(default_factory=dict, compare=False, hash=False)
 
     def __post_init__(self) -> None:
         (xmin, ymin), (xmax, ymax) = self.bounds
+        if not all(math.isfinite(v) for v in (xmin, ymin, xmax, ymax)):
+            raise ValueError(f"scene {self.name!r}: bounds must be finite, got {self.bounds!r}")
         if not (xmax > xmin and ymax > ymin):
             raise ValueError(f"scene {self.name!r}: empty bounds {self.bounds!r}")
+        if not all(isinstance(m, MeshPart) for m in self.meshes):
+            raise ValueError(f"scene {self.name!r}: meshes must be MeshPart objects")
+        low, high = self.height_band
+        if not (0 <= low < high):
+            raise ValueError(f"scene {self.name!r}: height_band must be (low, high) metres "
+                             f"with 0 <= low < high, got {self.height_band!r}")
+        if self.sky_color is not None:
+            _check_color(f"scene {self.name!r} sky", (*self.sky_color, 1.0))
         for lm in self.landmarks:
             x, y = lm.position
             hx, hy = lm.footprint_half_size
@@ -191,7 +219,8 @@ def _obstacles(scene: Scene) -> _Obstacles:
 def clearances(scene: Scene, points) -> np.ndarray:
     """:func:`clearance` of many floor points ``(N, 2)`` (metres) at once: the distance
     to each wall's centre line less half its thickness, to each landmark's footprint
-    (a cylinder's disc, a box's rotated rectangle; 0 inside) and to the bounds."""
+    (a cylinder's disc, a box's rotated rectangle; 0 inside), to the bounds and to the
+    colliding mesh parts in the height band (:mod:`homing_gym.scenes.footprint`)."""
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
     (xmin, ymin), (xmax, ymax) = scene.bounds
     free = np.minimum(np.minimum(pts[:, 0] - xmin, xmax - pts[:, 0]),
@@ -210,6 +239,9 @@ def clearances(scene: Scene, points) -> np.ndarray:
         lx = np.maximum(np.abs(c * d[..., 0] + s * d[..., 1]) - ob.half_extent[:, 0], 0.0)
         ly = np.maximum(np.abs(-s * d[..., 0] + c * d[..., 1]) - ob.half_extent[:, 1], 0.0)
         free = np.minimum(free, np.min(np.maximum(np.hypot(lx, ly) - ob.radius, 0.0), axis=1))
+    if scene.meshes:
+        free = np.minimum(free, mesh_clearances(scene.meshes, scene.bounds, scene.height_band,
+                                                pts))
     return free
 
 

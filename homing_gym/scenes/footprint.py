@@ -1,0 +1,144 @@
+"""Where mesh parts block the robot: their cut through the height band, rasterised.
+
+The robot drives on the plane z = 0. A mesh part's triangles block it where they pass
+through the scene's ``height_band`` = (low, high) metres above the floor (default
+0.02-0.35 m: above floor-level detail such as rugs or the mesh's own ground, up to just
+over the camera): a table's legs block, its top does not. The triangles are clipped to the
+band with ``trimesh.intersections.slice_faces_plane``; the clipped polygons, seen from
+above, are filled into an occupancy grid (OpenCV, sub-pixel precision; a vertical wall
+fills the cells its trace crosses) and ``scipy.ndimage.distance_transform_edt`` gives each
+cell's distance to the nearest blocked cell. :func:`mesh_clearances` reads that field with
+bilinear interpolation, less one cell size, so it never claims more room than there is
+(it may claim up to about one cell less). The inside of a closed solid (a watertight
+component wound outwards: a pillar, a rock) is blocked too: its cross-sections at
+:data:`SECTION_LEVELS` heights in the band are filled; an inward-wound shell (a room
+modelled as one box seen from inside) and open surfaces block only along their faces. The same clipped triangles become the
+PyBullet collision body (:mod:`homing_gym.simulator`), so what the planner avoids is
+what the robot bumps into.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import cv2
+import numpy as np
+from scipy import ndimage
+
+from homing_gym.scenes.mesh_part import MeshPart
+
+#: Finest grid cell (metres) and the most cells a field may have (coarser for big worlds).
+RESOLUTION, MAX_CELLS = 0.02, 4_000_000
+#: Cells of grid beyond the scene bounds (obstacles just outside still narrow the room).
+MARGIN = 0.5
+_SHIFT = 8          # OpenCV sub-pixel bits
+#: Heights per closed solid at which its inside is cut (spread over the height band).
+SECTION_LEVELS = 3
+
+
+def band_faces(part: MeshPart, band: tuple[float, float]) -> np.ndarray:
+    """Indices of the faces of ``part`` whose height range meets ``band`` (metres)."""
+    z = part.triangles[:, :, 2]
+    return np.flatnonzero((z.max(axis=1) >= band[0]) & (z.min(axis=1) <= band[1]))
+
+
+def band_triangles(part: MeshPart, band: tuple[float, float]) -> np.ndarray:
+    """Corners ``(M, 3, 3)`` of the triangles of ``part`` clipped to ``low <= z <= high``."""
+    from trimesh.intersections import slice_faces_plane   # only mesh worlds need trimesh
+
+    faces = part.faces[band_faces(part, band)]
+    if len(faces) == 0:
+        return np.zeros((0, 3, 3))
+    vertices = part.vertices
+    for normal, origin in (((0, 0, 1), (0, 0, band[0])), ((0, 0, -1), (0, 0, band[1]))):
+        vertices, faces = slice_faces_plane(vertices, faces, np.array(normal, float),
+                                            np.array(origin, float))[:2]
+        if len(faces) == 0:
+            return np.zeros((0, 3, 3))
+    return np.asarray(vertices)[np.asarray(faces)]
+
+
+@dataclass(frozen=True)
+class ClearanceField:
+    """Distance (metres) from each grid point to the nearest blocked cell, less one cell;
+    ``field[i, j]`` at floor point ``origin + (i, j) * resolution``."""
+
+    field: np.ndarray
+    origin: tuple[float, float]
+    resolution: float
+
+    def __call__(self, points: np.ndarray) -> np.ndarray:
+        """Clearance at floor points ``(N, 2)``; 0 outside the grid."""
+        idx = (np.asarray(points, np.float64) - self.origin) / self.resolution
+        return ndimage.map_coordinates(self.field, idx.T, order=1, mode="constant", cval=0.0)
+
+
+def rasterise(polygons: list[np.ndarray], origin, resolution: float,
+              shape: tuple[int, int]) -> np.ndarray:
+    """Boolean grid ``shape = (nx, ny)``, True in every cell a polygon (floor points,
+    metres) covers or whose outline crosses."""
+    grid = np.zeros((shape[1], shape[0]), np.uint8)          # OpenCV: rows are y
+    if polygons:
+        scale = 2 ** _SHIFT / resolution
+        pts = [np.round((np.asarray(p) - origin) * scale).astype(np.int32) for p in polygons]
+        cv2.fillPoly(grid, pts, 1, cv2.LINE_8, _SHIFT)
+        cv2.polylines(grid, pts, True, 1, 1, cv2.LINE_8, _SHIFT)
+    return grid.T.astype(bool)
+
+
+def solid_sections(part: MeshPart, band: tuple[float, float],
+                   levels: int = SECTION_LEVELS) -> list[list[np.ndarray]]:
+    """Cross-sections of the closed solids of ``part``: for each watertight, outward-wound
+    component (``trimesh`` ``is_volume``) that meets ``band``, its cut at ``levels``
+    heights spread over the band, each cut a list of closed floor loops ``(n, 2)``."""
+    import trimesh
+
+    if len(band_faces(part, band)) == 0:
+        return []
+    cuts = []
+    for solid in trimesh.Trimesh(part.vertices, part.faces).split(only_watertight=True):
+        low, high = max(band[0], solid.bounds[0, 2]), min(band[1], solid.bounds[1, 2])
+        if low > high or not solid.is_volume:    # out of the band, or a shell wound inwards
+            continue
+        for z in np.linspace(low, high, levels + 2)[1:-1]:
+            section = solid.section(plane_origin=(0.0, 0.0, z), plane_normal=(0.0, 0.0, 1.0))
+            if section is not None:
+                cuts.append([np.asarray(loop)[:, :2] for loop in section.discrete])
+    return cuts
+
+
+def clearance_field(parts: tuple[MeshPart, ...], bounds, band) -> ClearanceField | None:
+    """The field of the colliding ``parts`` over ``bounds`` (plus :data:`MARGIN`): their
+    triangles in ``band`` and the insides of their closed solids; ``None`` when none of
+    them reaches into ``band``."""
+    colliding = [part for part in parts if part.collision]
+    polygons = [tri[:, :2] for part in colliding for tri in band_triangles(part, band)]
+    if not polygons:
+        return None
+    solids = [cut for part in colliding for cut in solid_sections(part, band)]
+    (xmin, ymin), (xmax, ymax) = bounds
+    width, depth = xmax - xmin + 2 * MARGIN, ymax - ymin + 2 * MARGIN
+    resolution = max(RESOLUTION, math.sqrt(width * depth / MAX_CELLS))
+    shape = (int(math.ceil(width / resolution)) + 1, int(math.ceil(depth / resolution)) + 1)
+    origin = np.array([xmin - MARGIN, ymin - MARGIN])
+    blocked = rasterise(polygons, origin, resolution, shape)
+    for cut in solids:       # each cut filled on its own: even-odd within it (holes)
+        blocked |= rasterise(cut, origin, resolution, shape)
+    distance = ndimage.distance_transform_edt(~blocked) * resolution - resolution
+    return ClearanceField(np.maximum(distance, 0.0), (float(origin[0]), float(origin[1])),
+                          resolution)
+
+
+@lru_cache(maxsize=16)
+def _field(parts: tuple[MeshPart, ...], bounds, band) -> ClearanceField | None:
+    return clearance_field(parts, bounds, band)
+
+
+def mesh_clearances(parts: tuple[MeshPart, ...], bounds, band, points) -> np.ndarray:
+    """Free distance (metres) from floor points ``(N, 2)`` to the nearest colliding mesh
+    triangle in ``band`` (``inf`` when no part blocks anything); cached per world."""
+    field = _field(parts, bounds, band)
+    pts = np.asarray(points, np.float64).reshape(-1, 2)
+    return np.full(len(pts), np.inf) if field is None else field(pts)

@@ -1,0 +1,73 @@
+"""Triangle meshes in a scene: :class:`MeshPart`, plain arrays in world coordinates.
+
+A part is what a user's mesh file (or a procedural generator) adds to a
+:class:`~homing_gym.scenes.base.Scene` beside its walls and landmarks. Units: metres,
+z up, the floor at z = 0. Both renderers draw it (the ray caster with its texture, if it
+has one; TinyRenderer with its face colours) and, with ``collision``, the robot bumps
+into its triangles that reach into the scene's height band
+(:mod:`homing_gym.scenes.footprint`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True, eq=False)
+class MeshPart:
+    """``vertices`` ``(V, 3)`` (metres), ``faces`` ``(F, 3)`` vertex indices,
+    ``face_colors`` ``(F, 3)`` RGB in ``[0, 1]``; optionally ``uvs`` ``(V, 2)`` (u left
+    to right, v bottom to top) and ``texture`` (uint8 ``(H, W, 3)``, row 0 at the top),
+    which the ray caster uses instead of the face colours. ``collision``: the robot
+    bumps into it. Parts compare by identity (their arrays are not hashed)."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    face_colors: np.ndarray
+    uvs: np.ndarray | None = None
+    texture: np.ndarray | None = None
+    collision: bool = True
+    name: str = "mesh"
+
+    def __post_init__(self) -> None:
+        owner = f"mesh part {self.name!r}"
+        vertices = np.asarray(self.vertices, np.float64)
+        faces = np.asarray(self.faces)
+        if vertices.ndim != 2 or vertices.shape[1] != 3 or len(vertices) == 0:
+            raise ValueError(f"{owner}: vertices must be a non-empty (V, 3) array, "
+                             f"got shape {vertices.shape}")
+        if not np.all(np.isfinite(vertices)):
+            raise ValueError(f"{owner}: vertices contain NaN or infinity "
+                             f"({int(np.sum(~np.isfinite(vertices)))} values)")
+        if faces.ndim != 2 or faces.shape[1] != 3 or len(faces) == 0:
+            raise ValueError(f"{owner}: has no faces (faces must be a non-empty (F, 3) "
+                             f"array of vertex indices, got shape {faces.shape})")
+        if faces.dtype.kind not in "iu" or faces.min() < 0 or faces.max() >= len(vertices):
+            raise ValueError(f"{owner}: face indices must be integers in "
+                             f"[0, {len(vertices) - 1}]")
+        colors = np.asarray(self.face_colors, np.float64)
+        if colors.shape != (len(faces), 3) or not np.all((colors >= 0) & (colors <= 1)):
+            raise ValueError(f"{owner}: face_colors must be ({len(faces)}, 3) RGB values "
+                             f"in [0, 1], got shape {colors.shape}")
+        if (self.uvs is None) != (self.texture is None):
+            raise ValueError(f"{owner}: give both uvs and texture, or neither")
+        if self.texture is not None:
+            uvs, texture = np.asarray(self.uvs, np.float64), np.asarray(self.texture)
+            if uvs.shape != (len(vertices), 2) or not np.all(np.isfinite(uvs)):
+                raise ValueError(f"{owner}: uvs must be finite ({len(vertices)}, 2), "
+                                 f"got shape {uvs.shape}")
+            if texture.ndim != 3 or texture.shape[2] != 3 or texture.dtype != np.uint8:
+                raise ValueError(f"{owner}: texture must be uint8 (H, W, 3), got "
+                                 f"{texture.dtype} {texture.shape}")
+            object.__setattr__(self, "uvs", uvs)
+            object.__setattr__(self, "texture", texture)
+        object.__setattr__(self, "vertices", vertices)
+        object.__setattr__(self, "faces", faces.astype(np.int64))
+        object.__setattr__(self, "face_colors", colors)
+
+    @property
+    def triangles(self) -> np.ndarray:
+        """Corners ``(F, 3, 3)`` of every face (metres)."""
+        return self.vertices[self.faces]
