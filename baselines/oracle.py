@@ -1,12 +1,13 @@
-"""``oracle``: drives home along the true shortest path, reading the true pose.
+"""``oracle``: drives to each goal along the true shortest path, reading the true pose.
 
 The upper bound of every comparison and a check of the harness: it is the one controller
 that is given the env (``needs_env = True``) and reads ``env.unwrapped.pose``,
-``episode.home`` and ``scene``. It plans a collision-free shortest path around obstacles
-(:func:`homing_gym.paths.shortest_path`) once per episode and, at every decision, moves
-at most ``step_length`` metres towards the farthest path waypoint it can see; with
-``success_on="stop"`` it stops once within ``arrive_tolerance`` of home, after turning to
-the home heading if ``align_heading``.
+``goal_pose`` (home, or the current target of a route, which the env advances as targets
+are reached) and ``scene``. It plans a collision-free shortest path around obstacles
+(:func:`homing_gym.paths.shortest_path`) once per goal and, at every decision, moves at
+most ``step_length`` metres towards the farthest path waypoint it can see; with
+``success_on="stop"`` it stops once within ``arrive_tolerance`` of the goal, after turning
+to the goal heading if ``align_heading``: at home, and at every target of a route in turn.
 """
 
 from __future__ import annotations
@@ -26,9 +27,9 @@ from homing_gym.validation import require_positive
 @dataclass
 class OracleController(Controller):
     """Parameters (metres, radians): ``step_length`` longest move between decisions;
-    ``arrive_tolerance`` distance to home at which it stops; ``align_heading`` turn to the
-    home heading before stopping, within ``heading_tolerance``; ``margin`` clearance kept
-    from obstacles when planning."""
+    ``arrive_tolerance`` distance to the goal at which it stops; ``align_heading`` turn to
+    the goal heading before stopping, within ``heading_tolerance``; ``margin`` clearance
+    kept from obstacles when planning."""
 
     step_length: float = 0.1
     arrive_tolerance: float = 0.03
@@ -49,19 +50,20 @@ class OracleController(Controller):
 
     def on_reset(self) -> None:
         self._path: list | None = None
+        self._path_goal: tuple[float, float] | None = None
 
     def decide(self, observation) -> Move | None:
         env = getattr(self, "_env", None)
         if env is None:
             raise RuntimeError("oracle: attach_env(env) must be called before predict()")
-        pose, home, scene = env.pose, env.episode.home, env.scene
-        distance = math.hypot(home[0] - pose[0], home[1] - pose[1])
+        pose, goal, scene = env.pose, env.goal_pose, env.scene
+        distance = math.hypot(goal[0] - pose[0], goal[1] - pose[1])
         if distance < self.arrive_tolerance:
-            turn = wrap_angle(home[2] - pose[2])
+            turn = wrap_angle(goal[2] - pose[2])
             if self.align_heading and abs(turn) > self.heading_tolerance:
                 return Move(turn, 0.0)
             return None
-        return self.move_to(pose, self.waypoint(scene, pose, home))
+        return self.move_to(pose, self.waypoint(scene, pose, goal))
 
     def move_to(self, pose, target) -> Move:
         """The move from ``pose`` towards the floor point ``target``: turn to it, drive at
@@ -69,21 +71,22 @@ class OracleController(Controller):
         return Move(bearing_to(pose, target),
                     min(self.step_length, math.hypot(target[0] - pose[0], target[1] - pose[1])))
 
-    def waypoint(self, scene, pose, home) -> tuple[float, float]:
-        """Home if the straight way from ``pose`` is free, else the farthest visible
-        waypoint of the shortest path (planned once per episode, replanned when lost)."""
-        xy = (float(pose[0]), float(pose[1]))
+    def waypoint(self, scene, pose, goal) -> tuple[float, float]:
+        """The goal if the straight way from ``pose`` is free, else the farthest visible
+        waypoint of the shortest path (planned once per goal, replanned when lost)."""
+        xy, goal_xy = (float(pose[0]), float(pose[1])), (float(goal[0]), float(goal[1]))
         # slack for drift off the planned path, and for a robot already pushed close to
         # an obstacle (never below the body radius plus a contact margin)
         see = max(min(self.margin, clearance(scene, xy)) - 0.02, 0.17)
-        if segment_free(scene, xy, home, min(self.margin, see + 0.02)):
-            return home[0], home[1]
+        if segment_free(scene, xy, goal_xy, min(self.margin, see + 0.02)):
+            return goal_xy
         for attempt in range(2):
-            if self._path is None or attempt == 1:
+            if self._path is None or self._path_goal != goal_xy or attempt == 1:
                 try:
-                    self._path = shortest_path(scene, xy, home, self.margin)
+                    self._path = shortest_path(scene, xy, goal_xy, self.margin)
                 except NoPathError:
-                    return home[0], home[1]
+                    return goal_xy
+                self._path_goal = goal_xy
             for waypoint in reversed(self._path[1:]):
                 if segment_free(scene, xy, waypoint, see):
                     return waypoint

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from homing_gym.env import HomingEnv
@@ -149,7 +151,8 @@ class RouteFollowingEnv(HomingEnv):
     (0.3048 m) apart along the centre line of the ``hallway`` scene, all facing along the
     corridor. The robot starts 1 ft before the first target and must home to each target
     in turn; the goal observation is the snapshot of the current target and switches to
-    the next one when a target is reached.
+    the next one when a target is reached. ``route`` gives any other route, curved or
+    not, in any scene: the robot's start point followed by the targets.
 
     ## Action space
 
@@ -173,8 +176,9 @@ class RouteFollowingEnv(HomingEnv):
 
     ## Starting state
 
-    1 ft before the first target, on the route line, perturbed uniformly by up to
-    ``start_jitter`` = (0.05 m, 10 degrees) in x, y and heading, drawn from the seed.
+    1 ft before the first target, on the route line (with ``route``: its first point),
+    perturbed uniformly by up to ``start_jitter`` = (0.05 m, 10 degrees) in x, y and
+    heading, drawn from the seed.
     With ``lighting_change > 0`` the lighting of the run differs from the lighting of
     the snapshots.
 
@@ -195,11 +199,18 @@ class RouteFollowingEnv(HomingEnv):
 
     ## Arguments
 
-    ``scene`` (default ``"hallway"``; any scene with ``metadata["route_origin"]``),
-    ``n_targets`` = 17, ``spacing`` = 0.3048, ``start_jitter``, ``success_radius``,
-    ``success_on``, ``reward``, ``lighting_change`` = 0 (0-1: strength of the
-    illumination change between snapshots and run: light direction, brightness,
-    contrast), and every camera and robot argument of ``LocalHoming-v0``.
+    ``scene`` (default ``"hallway"``; any scene with ``metadata["route_origin"]``, or any
+    scene with ``route``), ``n_targets`` = 17, ``spacing`` = 0.3048, ``route`` = ``None``
+    (a sequence of at least two points ``(x, y)`` or ``(x, y, yaw)``, metres and radians
+    counter-clockwise from +x, e.g. ``[(1, 0), (2, 0.3), (3, 0)]``: the first is where the
+    robot starts, the others are the targets in order; a missing yaw is the direction of
+    travel from the previous point; consecutive points at least 0.05 m apart, every point
+    inside the scene with 0.18 m of clearance; replaces the straight route, so
+    ``n_targets`` and ``spacing`` must then keep their defaults), ``start_jitter``,
+    ``success_radius``, ``success_on``, ``reward``, ``lighting_change`` = 0 (0-1: strength
+    of the illumination change between snapshots and run: light direction, brightness,
+    contrast), and every camera and robot argument of ``LocalHoming-v0``. A bad ``route``
+    raises ``ValueError``.
 
     ## Version history
 
@@ -207,10 +218,11 @@ class RouteFollowingEnv(HomingEnv):
     """
 
     def __init__(self, scene: str | Scene = "hallway", *, n_targets: int = 17,
-                 spacing: float = FOOT, start_jitter: tuple[float, float] = (0.05, 0.1745),
+                 spacing: float = FOOT, route: Sequence[Sequence[float]] | None = None,
+                 start_jitter: tuple[float, float] = (0.05, 0.1745),
                  success_radius: float = 0.1, success_on: str = "reach",
                  reward: RewardConfig = RewardConfig(), **kwargs):
-        task = RouteFollowingTask(n_targets=n_targets, spacing=spacing,
+        task = RouteFollowingTask(n_targets=n_targets, spacing=spacing, route=route,
                                   start_jitter=start_jitter, success_radius=success_radius,
                                   success_on=success_on, reward=reward)
         super().__init__(task, scene, **kwargs)

@@ -1,10 +1,12 @@
 """Route following: visit a sequence of target places, each known by its snapshot
 (Hong et al. 1991 §5: 17 targets about 1 ft apart in a hallway, the robot starting 1 ft
-before the first)."""
+before the first), or the targets of a route given as points (curved routes)."""
 
 from __future__ import annotations
 
 import math
+import numbers
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -15,48 +17,122 @@ from homing_gym.tasks.base import Episode
 from homing_gym.tasks.goal_reaching import GoalReachingTask, RewardConfig
 from homing_gym.validation import require_positive
 
+#: The straight route's defaults: Hong et al.'s 17 targets 1 ft apart.
+N_TARGETS, SPACING = 17, FOOT
+#: Least distance (metres) between consecutive points of a given route.
+MIN_ROUTE_STEP = 0.05
 
+
+def _is_sequence(value) -> bool:
+    """A list, tuple or array of at least one dimension (not a string)."""
+    return ((isinstance(value, Sequence) and not isinstance(value, str))
+            or (isinstance(value, np.ndarray) and value.ndim >= 1))
+
+
+def _route_point(k: int, point) -> tuple[float, ...]:
+    """Point ``k`` of a route as 2 or 3 floats; ``ValueError`` unless it is (x, y) or
+    (x, y, yaw) of finite real numbers."""
+    ok = (_is_sequence(point) and len(point) in (2, 3)
+          and all(isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(v)
+                  for v in point))
+    if not ok:
+        raise ValueError(f"route point {k} must be (x, y) or (x, y, yaw): 2 or 3 finite "
+                         f"numbers (metres, radians), got {point!r}")
+    return tuple(float(v) for v in point)
+
+
+def route_poses(route: Sequence[Sequence[float]]) -> np.ndarray:
+    """The poses ``(N, 3)`` (x, y, yaw; metres, radians counter-clockwise from +x) of a
+    route given as ``N >= 2`` points (x, y) or (x, y, yaw). A missing yaw is the direction
+    of travel from the previous point (for the first point: towards the second).
+    ``ValueError`` for fewer than two points, a bad point, or consecutive points less than
+    ``MIN_ROUTE_STEP`` metres apart."""
+    if not _is_sequence(route) or len(route) < 2:
+        raise ValueError(f"route must be a sequence of at least two points (x, y) or "
+                         f"(x, y, yaw), got {route!r}")
+    points = [_route_point(k, p) for k, p in enumerate(route)]
+    xy = np.array([p[:2] for p in points])
+    dx, dy = np.diff(xy, axis=0).T
+    for k, step in enumerate(np.hypot(dx, dy), start=1):
+        if step < MIN_ROUTE_STEP:
+            raise ValueError(f"route points {k - 1} {points[k - 1]} and {k} {points[k]} are "
+                             f"{step:.3f} m apart; consecutive points must be at least "
+                             f"{MIN_ROUTE_STEP} m apart")
+    travel = np.arctan2(dy, dx)
+    travel = np.concatenate([travel[:1], travel])
+    yaws = [wrap_angle(p[2]) if len(p) == 3 else a for p, a in zip(points, travel)]
+    return np.column_stack([xy, yaws])
 
 
 class RouteFollowingTask(GoalReachingTask):
-    """``n_targets`` target poses ``spacing`` metres apart on a straight line from the
-    scene's ``metadata["route_origin"]`` (x, y, yaw), all facing along the route. The
-    robot starts ``spacing`` metres before the first target, perturbed by up to
-    ``start_jitter = (metres, radians)`` (uniform in x, y and yaw). A target counts as
-    reached within ``success_radius`` (default 0.1 m, a third of the spacing), or, with
-    ``success_on="stop"``, when the agent stops; then the next target's snapshot becomes
-    the goal."""
+    """By default ``n_targets`` target poses ``spacing`` metres apart on a straight line
+    from the scene's ``metadata["route_origin"]`` (x, y, yaw), all facing along the route,
+    the robot starting ``spacing`` metres before the first target. With ``route`` (points
+    (x, y) or (x, y, yaw), see :func:`route_poses`) the robot starts at its first point and
+    the other points are the targets, in order; ``n_targets`` and ``spacing`` must then
+    keep their defaults. The start is perturbed by up to ``start_jitter = (metres,
+    radians)`` (uniform in x, y and yaw). Every point needs ``clearance_margin`` metres of
+    clearance in the scene. A target counts as reached within ``success_radius`` (default
+    0.1 m, a third of the spacing), or, with ``success_on="stop"``, when the agent stops;
+    then the next target's snapshot becomes the goal."""
 
-    def __init__(self, n_targets: int = 17, spacing: float = FOOT,
+    def __init__(self, n_targets: int = N_TARGETS, spacing: float = SPACING,
                  start_jitter: tuple[float, float] = (0.05, math.radians(10)),
                  success_radius: float = 0.1, success_on: str = "reach",
-                 reward: RewardConfig = RewardConfig(), clearance_margin: float = 0.18):
+                 reward: RewardConfig = RewardConfig(), clearance_margin: float = 0.18,
+                 route: Sequence[Sequence[float]] | None = None):
         if not (isinstance(n_targets, (int, np.integer)) and n_targets >= 1):
             raise ValueError(f"n_targets must be an integer >= 1, got {n_targets!r}")
         require_positive("spacing", spacing, "metres")
         if len(start_jitter) != 2 or not all(math.isfinite(v) and v >= 0 for v in start_jitter):
             raise ValueError(f"start_jitter must be (metres, radians) >= 0, got {start_jitter!r}")
+        if route is not None and (n_targets != N_TARGETS or spacing != SPACING):
+            raise ValueError(f"n_targets ({n_targets!r}) and spacing ({spacing!r}) describe the "
+                             f"straight route; with a route given they must keep their "
+                             f"defaults ({N_TARGETS}, {SPACING}): the route's points set both")
         super().__init__(success_radius, success_on, reward)
-        self.n_targets = int(n_targets)
+        self.route = None if route is None else route_poses(route)
+        self.n_targets = int(n_targets) if route is None else len(self.route) - 1
         self.spacing = float(spacing)
         self.start_jitter = (float(start_jitter[0]), float(start_jitter[1]))
         self.clearance_margin = clearance_margin
 
     def _route(self, scene: Scene) -> list[np.ndarray]:
+        """The start point, then the targets."""
+        if self.route is not None:
+            return [pose.copy() for pose in self.route]
         x0, y0, yaw = scene.metadata["route_origin"]
         c, s = math.cos(yaw), math.sin(yaw)
         return [np.array([x0 + k * self.spacing * c, y0 + k * self.spacing * s, yaw])
                 for k in range(-1, self.n_targets)]
 
     def check_scene(self, scene: Scene) -> None:
+        if self.route is not None:
+            for k, pose in enumerate(self.route):
+                self._check_route_point(scene, k, pose)
+            return
         if "route_origin" not in scene.metadata:
             raise ValueError(f"scene {scene.name!r} defines no route (metadata['route_origin']); "
-                             f"use a scene with one, e.g. 'hallway'")
+                             f"use a scene with one, e.g. 'hallway', or give route=[...]")
         for pose in self._route(scene):
             if clearance(scene, (pose[0], pose[1])) < self.clearance_margin:
                 raise ValueError(
                     f"{self.n_targets} targets {self.spacing} m apart do not fit along the "
                     f"route of scene {scene.name!r}: ({pose[0]:.2f}, {pose[1]:.2f}) is blocked")
+
+    def _check_route_point(self, scene: Scene, k: int, pose: np.ndarray) -> None:
+        """``ValueError`` if point ``k`` of the given route lies outside ``scene.bounds``
+        or has less than ``clearance_margin`` metres of clearance."""
+        (xmin, ymin), (xmax, ymax) = scene.bounds
+        where = f"route point {k} ({pose[0]:.3f}, {pose[1]:.3f})"
+        if not (xmin <= pose[0] <= xmax and ymin <= pose[1] <= ymax):
+            raise ValueError(f"{where} lies outside the bounds of scene {scene.name!r}: "
+                             f"x in [{xmin}, {xmax}], y in [{ymin}, {ymax}] m")
+        free = clearance(scene, (pose[0], pose[1]))
+        if free < self.clearance_margin:
+            raise ValueError(f"{where} is blocked in scene {scene.name!r}: {free:.3f} m from "
+                             f"the nearest wall or object, at least {self.clearance_margin} m "
+                             f"needed")
 
     def sample_episode(self, scene: Scene, rng: np.random.Generator) -> Episode:
         before, *targets = self._route(scene)

@@ -116,3 +116,41 @@ def test_oracle_discrete_actions_reach_home(make_env, controller_for):
     env = make_env(ENV_ID, action_type="discrete", max_episode_steps=300)
     record = run_episode(env, controller_for("oracle", env), 4)
     assert record.success and record.final_distance < 0.15
+
+
+#: Routes as (scene, points): an S of 6 targets in the hallway; an L round the corner of
+#: the house's living room into the bedroom (x = 3.5, then through the door at y = 1.5);
+#: targets in the kitchen and then the bedroom of the house, each reached only round the
+#: walls (the oracle plans a path for each target).
+ROUTES = {
+    "hallway-s": ("hallway", [(1.0 + 0.5 * k, 0.4 * math.sin(k * math.pi / 3))
+                              for k in range(7)]),
+    "house-l": ("house", [(2.0, 3.0), (2.75, 3.0), (3.5, 3.0), (3.5, 2.25), (3.5, 1.5),
+                          (4.5, 1.5), (5.5, 1.5)]),
+    "house-rooms": ("house", [(2.0, 3.0), (6.0, 4.5), (6.0, 1.5)]),
+}
+
+
+@pytest.mark.parametrize("route", sorted(ROUTES))
+def test_oracle_stops_at_every_target_of_a_route(route, make_env, controller_for):
+    scene, points = ROUTES[route]
+    env = make_env("homing_gym/RouteFollowing-v0", scene=scene, route=points,
+                   success_on="stop", panorama_shape=(16, 64), max_episode_steps=800)
+    oracle = controller_for("oracle", env)
+    obs, info = env.reset(seed=0)
+    oracle.reset(0)
+    goals = env.unwrapped.episode.goals
+    stops, terminated, truncated, t = [], False, False, 0
+    while not (terminated or truncated):
+        action, _ = oracle.predict(obs, episode_start=t == 0)
+        index = info["target_index"]
+        obs, _, terminated, truncated, info = env.step(action)
+        t += 1
+        if terminated or info["target_index"] != index:      # the oracle stopped there
+            assert info["target_index"] == min(index + 1, len(goals) - 1)
+            stops.append((index, env.unwrapped.pose.copy()))
+    assert terminated and info["is_success"]
+    assert [k for k, _ in stops] == list(range(len(goals)))
+    assert len(info["target_errors"]) == len(goals) and max(info["target_errors"]) < 0.05
+    for k, pose in stops:
+        assert abs(math.remainder(pose[2] - goals[k][2], 2 * math.pi)) < 0.1

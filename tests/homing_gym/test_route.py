@@ -1,4 +1,7 @@
-"""RouteFollowing-v0: the route's geometry, goal switching, per-target errors, both modes."""
+"""RouteFollowing-v0: the route's geometry, goal switching, per-target errors, both modes,
+routes given as points."""
+
+import math
 
 import numpy as np
 import pytest
@@ -76,3 +79,62 @@ def test_lighting_change_alters_the_run_but_not_the_snapshots(make_env):
     assert np.array_equal(a["goal"], b["goal"])
     assert np.abs(a["panorama"].astype(int) - b["panorama"]).mean() > 3
     assert np.array_equal(b["panorama"], c["panorama"])
+
+
+def test_default_route_is_the_straight_route(make_env):
+    env = make_env(ROUTE, start_jitter=(0.0, 0.0))
+    env.reset(seed=1)
+    x0, y0, yaw = env.unwrapped.scene.metadata["route_origin"]
+    episode = env.unwrapped.episode
+    straight = [(x0 + k * FOOT * math.cos(yaw), y0 + k * FOOT * math.sin(yaw), yaw)
+                for k in range(17)]
+    assert np.allclose(episode.goals, straight)
+    assert np.allclose(episode.start, (x0 - FOOT, y0, yaw))
+
+
+def test_given_route_sets_start_targets_and_travel_yaw(make_env):
+    route = [(1.0, 0.0), (1.5, 0.5), (2.0, 0.5, 1.0), (2.5, 0.0), (2.0, -0.5)]
+    env = make_env(ROUTE, route=route, start_jitter=(0.0, 0.0))
+    _, info = env.reset(seed=0)
+    episode = env.unwrapped.episode
+    assert np.allclose(episode.start, (1.0, 0.0, math.pi / 4))     # towards the first target
+    assert np.allclose(episode.goals, [(1.5, 0.5, math.pi / 4),        # travel direction
+                                       (2.0, 0.5, 1.0),                 # given
+                                       (2.5, 0.0, -math.pi / 4),
+                                       (2.0, -0.5, -3 * math.pi / 4)])
+    assert np.allclose(info["pose"], episode.start, atol=1e-3)
+    assert info["target_index"] == 0 and np.allclose(info["goal_pose"], episode.goals[0])
+
+
+def test_given_route_needs_no_route_origin(make_env):
+    plain = Scene("plain", ((-1, -1), (1, 1)), walls=square_walls(2.0))
+    env = make_env(ROUTE, scene=plain, route=[(-0.5, 0.0), (0.0, 0.0), (0.5, 0.5)])
+    env.reset(seed=0)
+    assert len(env.unwrapped.episode.goals) == 2
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"route": [(1.0, 0.0)]}, "at least two points"),
+    ({"route": []}, "at least two points"),
+    ({"route": "1,0 2,0"}, "at least two points"),
+    ({"route": [(1.0, 0.0), (2.0, float("nan"))]}, r"route point 1 must be .* finite"),
+    ({"route": [(1.0, 0.0), (2.0, 0.0, float("inf"))]}, r"route point 1 must be .* finite"),
+    ({"route": [(1.0, 0.0), (2.0,)]}, r"route point 1 must be \(x, y\) or \(x, y, yaw\)"),
+    ({"route": [(1.0, 0.0), (2.0, 0.0, 0.0, 0.0)]}, r"route point 1 must be"),
+    ({"route": [(1.0, 0.0), 2.0]}, r"route point 1 must be"),
+    ({"route": [(1.0, 0.0), ("2", 0.0)]}, r"route point 1 must be"),
+    ({"route": [(1.0, 0.0), (2.0, 0.0), (2.0, 0.0)]}, r"points 1 .* and 2 .* are 0.000 m apart"),
+    ({"route": [(1.0, 0.0), (1.03, 0.0)]}, r"at least 0.05 m apart"),
+    ({"route": [(1.0, 0.0), (9.0, 0.0)]}, r"route point 1 \(9.000, 0.000\) lies outside the "
+                                          r"bounds .* x in \[0.0, 8.0\]"),
+    ({"route": [(1.0, 0.0), (2.0, 0.85)]}, r"route point 1 \(2.000, 0.850\) is blocked .* "
+                                           r"at least 0.18 m"),
+    ({"route": [(2.7, 0.6), (3.5, 0.0)]}, r"route point 0 .* is blocked"),        # the bin
+    ({"route": [(1.0, 0.0), (2.0, 0.0)], "n_targets": 5}, r"n_targets \(5\) and spacing"),
+    ({"route": [(1.0, 0.0), (2.0, 0.0)], "spacing": 0.5}, r"spacing \(0.5\)"),
+])
+def test_bad_routes_are_refused(kwargs, message):
+    import gymnasium as gym
+
+    with pytest.raises(ValueError, match=message):
+        gym.make(ROUTE, **kwargs)
