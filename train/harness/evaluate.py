@@ -193,11 +193,14 @@ def run_episode(env: gym.Env, policy, seed: int, start: Sequence[float] | None =
     run = rollout(env, policy, seed, options)
     home = np.asarray(run.reset_info["home_pose"], dtype=np.float64)
     start_pose = np.asarray(run.reset_info["start_pose"], dtype=np.float64)
-    # the scene and the body radius are public attributes, read for path-length metrics
-    scene, radius = env.unwrapped.scene, env.unwrapped.robot_config.body_radius
+    # the scene, the body radius and the episode's goals are public attributes, read for
+    # path-length metrics: the shortest path visits every goal of a route in order
+    unwrapped = env.unwrapped
+    scene, radius = unwrapped.scene, unwrapped.robot_config.body_radius
     traj = run.poses[:, :2]
     final = run.poses[-1]
-    shortest = _geodesic(scene, start_pose, home, radius)
+    stops = [start_pose, *unwrapped.episode.goals]
+    shortest = sum(_geodesic(scene, a, b, radius) for a, b in zip(stops[:-1], stops[1:]))
     final_geodesic = _geodesic(scene, final, home, radius)
     p = path_length(traj)
     success = bool(run.info.get("is_success", False))

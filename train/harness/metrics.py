@@ -4,7 +4,8 @@ Definitions (metres, radians unless named otherwise):
 
 * path length ``p``: sum of the distances between consecutive recorded positions;
 * ``spl`` = ``s * l / max(l, p)`` (Anderson et al. 2018), ``s`` success (0/1), ``l`` the
-  shortest collision-free start-home path length (:func:`homing_gym.paths.shortest_path`);
+  shortest collision-free start-home path length (:func:`homing_gym.paths.shortest_path`;
+  on a route, through every target in order);
 * ``soft_spl`` = ``max(0, 1 - d_T / l) * l / max(l, p)`` (Datta et al. 2021), ``d_T`` the
   shortest-path distance from the final position to home;
 * confidence intervals from ``scipy.stats``: a success rate's is the Wilson score interval

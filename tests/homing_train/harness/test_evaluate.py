@@ -3,6 +3,7 @@
 import csv
 import dataclasses
 import json
+import math
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -15,7 +16,7 @@ from homing_baselines.motion import Move
 from homing_train.harness import compare as compare_cli
 from homing_train.harness import eval_command as eval_cli
 from homing_train.harness import field as field_cli
-from homing_train.harness.evaluate import EvalResult, evaluate
+from homing_train.harness.evaluate import EvalResult, evaluate, run_episode
 
 ENV_ID = "homing_gym/LocalHoming-v0"
 SHORT = {"max_episode_steps": 8}
@@ -261,3 +262,16 @@ def test_ray_backend_gives_the_records_of_the_local_pool():
         return [{k: v for k, v in dataclasses.asdict(e).items() if k != "wall_time"}
                 for e in r.episodes]
     assert strip(runs[0]) == strip(runs[1]) and len(runs[1].episodes) == 3
+
+
+def test_route_shortest_path_visits_every_target(make_env, controller_for):
+    """On a route, SPL's shortest path runs start -> target 1 -> ... -> last target (here
+    straight legs in the open hallway: their summed lengths)."""
+    route = [(1.0, 0.0), (1.6, 0.3), (2.2, -0.2), (2.8, 0.3)]
+    env = make_env("homing_gym/RouteFollowing-v0", route=route, start_jitter=(0.0, 0.0),
+                   success_on="stop", max_episode_steps=300)
+    record = run_episode(env, controller_for("oracle", env), seed=0)
+    legs = sum(math.dist(a, b) for a, b in zip(route[:-1], route[1:]))
+    assert record.success
+    assert abs(record.shortest_path - legs) < 0.01
+    assert record.spl > 0.85
