@@ -126,6 +126,8 @@ class Simulator:
         body = c.createMultiBody(0, col, vis, [0, 0, 0])
         if scene.ground_plane:
             self._paint(body, scene.floor_color, scene.floor_texture)
+        else:
+            self._hide(body)
         c.changeDynamics(body, -1, lateralFriction=1.0)
         return body
 
@@ -143,10 +145,18 @@ class Simulator:
         cx, cy, hx, hy = (xmin + xmax) / 2, (ymin + ymax) / 2, (xmax - xmin) / 2, (ymax - ymin) / 2
         boxes = (((cx, ymin - t / 2), (hx + t, t / 2)), ((cx, ymax + t / 2), (hx + t, t / 2)),
                  ((xmin - t / 2, cy), (t / 2, hy + t)), ((xmax + t / 2, cy), (t / 2, hy + t)))
-        return [c.createMultiBody(0, c.createCollisionShape(p.GEOM_BOX,
-                                                            halfExtents=[*half, 0.5]),
-                                  -1, [*centre, 0.5])
-                for centre, half in boxes]
+        bodies = [c.createMultiBody(0, c.createCollisionShape(p.GEOM_BOX,
+                                                              halfExtents=[*half, 0.5]),
+                                    -1, [*centre, 0.5])
+                  for centre, half in boxes]
+        for body in bodies:
+            self._hide(body)
+        return bodies
+
+    def _hide(self, body: int) -> None:
+        """Keep PyBullet's renderers from drawing a body that has no visual shape (they
+        draw its collision shape otherwise)."""
+        self.client.changeVisualShape(body, -1, rgbaColor=[1, 1, 1, 0])
 
     def _make_part(self, part: MeshPart, band: tuple[float, float]) -> list[int]:
         """Bodies of a mesh part: one static concave collision body of its triangles that
@@ -160,6 +170,7 @@ class Simulator:
                                          indices=faces.ravel().tolist(),
                                          flags=p.GEOM_FORCE_CONCAVE_TRIMESH)
             bodies.append(c.createMultiBody(0, col, -1, [0, 0, 0]))
+            self._hide(bodies[-1])
         if self.caster is None:
             levels = np.round(part.face_colors * 16).astype(np.int64)
             keys = (levels[:, 0] * 17 + levels[:, 1]) * 17 + levels[:, 2]
@@ -170,6 +181,7 @@ class Simulator:
                     indices=group.ravel().tolist(),
                     rgbaColor=[*(levels[keys == key][0] / 16), 1.0])
                 bodies.append(c.createMultiBody(0, -1, vis, [0, 0, 0]))
+                c.changeVisualShape(bodies[-1], -1, textureUniqueId=-1)   # no default checker
         return bodies
 
     def _make_landmark(self, lm: Landmark) -> int:

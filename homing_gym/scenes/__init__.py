@@ -21,6 +21,8 @@ from homing_gym.scenes.lab import lab_scene
 from homing_gym.scenes.mesh_part import MeshPart
 from homing_gym.scenes.mesh_scene import MeshScene, mesh_scene_from_spec
 from homing_gym.scenes.random_arena import random_arena_scene
+from homing_gym.scenes.random_nature import random_nature_scene
+from homing_gym.scenes.random_rooms import random_rooms_scene
 
 
 @dataclass(frozen=True)
@@ -85,6 +87,14 @@ register_scene("lab", SceneFactory(
 register_scene("random_arena", SceneFactory(
     build=random_arena_scene, randomised=True,
     description="2.4 m square, 3-8 random landmarks and textures per episode"))
+register_scene("random_rooms", SceneFactory(
+    build=random_rooms_scene, randomised=True,
+    description="procedural indoor world per episode: 1-6 rooms with doors, furniture, "
+                "plants, pictures, random textures"))
+register_scene("random_nature", SceneFactory(
+    build=random_nature_scene, randomised=True,
+    description="procedural outdoor world per episode: open ground, trees, rocks, bushes, "
+                "distant hills, fenced 6-10 m square"))
 
 __all__ = ["MESH_PREFIX", "SHAPES", "Landmark", "MeshPart", "MeshScene", "Scene",
            "SceneFactory", "Wall", "available_scenes", "register_scene", "scene_factory",

@@ -10,9 +10,10 @@ fills the cells its trace crosses) and ``scipy.ndimage.distance_transform_edt`` 
 cell's distance to the nearest blocked cell. :func:`mesh_clearances` reads that field with
 bilinear interpolation, less one cell size, so it never claims more room than there is
 (it may claim up to about one cell less). The inside of a closed solid (a watertight
-component wound outwards: a pillar, a rock) is blocked too: its cross-sections at
-:data:`SECTION_LEVELS` heights in the band are filled; an inward-wound shell (a room
-modelled as one box seen from inside) and open surfaces block only along their faces. The same clipped triangles become the
+component wound outwards: a pillar, a rock) is blocked too: the floor outline of its
+triangles in the band is filled (``scipy.ndimage.binary_fill_holes``; a solid with a hole
+through it, a ring, is filled whole); an inward-wound shell (a room modelled as one box
+seen from inside) and open surfaces block only along their faces. The same clipped triangles become the
 PyBullet collision body (:mod:`homing_gym.simulator`), so what the planner avoids is
 what the robot bumps into.
 """
@@ -34,8 +35,6 @@ RESOLUTION, MAX_CELLS = 0.02, 4_000_000
 #: Cells of grid beyond the scene bounds (obstacles just outside still narrow the room).
 MARGIN = 0.5
 _SHIFT = 8          # OpenCV sub-pixel bits
-#: Heights per closed solid at which its inside is cut (spread over the height band).
-SECTION_LEVELS = 3
 
 
 def band_faces(part: MeshPart, band: tuple[float, float]) -> np.ndarray:
@@ -46,12 +45,16 @@ def band_faces(part: MeshPart, band: tuple[float, float]) -> np.ndarray:
 
 def band_triangles(part: MeshPart, band: tuple[float, float]) -> np.ndarray:
     """Corners ``(M, 3, 3)`` of the triangles of ``part`` clipped to ``low <= z <= high``."""
+    return clipped(part.vertices, part.faces[band_faces(part, band)], band)
+
+
+def clipped(vertices: np.ndarray, faces: np.ndarray, band: tuple[float, float]) -> np.ndarray:
+    """Corners ``(M, 3, 3)`` of the triangles ``faces`` clipped to ``low <= z <= high``
+    (``trimesh.intersections.slice_faces_plane`` at both planes)."""
     from trimesh.intersections import slice_faces_plane   # only mesh worlds need trimesh
 
-    faces = part.faces[band_faces(part, band)]
     if len(faces) == 0:
         return np.zeros((0, 3, 3))
-    vertices = part.vertices
     for normal, origin in (((0, 0, 1), (0, 0, band[0])), ((0, 0, -1), (0, 0, band[1]))):
         vertices, faces = slice_faces_plane(vertices, faces, np.array(normal, float),
                                             np.array(origin, float))[:2]
@@ -88,25 +91,38 @@ def rasterise(polygons: list[np.ndarray], origin, resolution: float,
     return grid.T.astype(bool)
 
 
-def solid_sections(part: MeshPart, band: tuple[float, float],
-                   levels: int = SECTION_LEVELS) -> list[list[np.ndarray]]:
-    """Cross-sections of the closed solids of ``part``: for each watertight, outward-wound
-    component (``trimesh`` ``is_volume``) that meets ``band``, its cut at ``levels``
-    heights spread over the band, each cut a list of closed floor loops ``(n, 2)``."""
+def solids(part: MeshPart, band: tuple[float, float]) -> list[np.ndarray]:
+    """The closed solids of ``part`` in ``band``: for each watertight, outward-wound
+    component (``trimesh`` ``split`` and ``is_volume``), its triangles clipped to the band
+    (:func:`clipped`), if any."""
     import trimesh
 
     if len(band_faces(part, band)) == 0:
         return []
-    cuts = []
+    found = []
     for solid in trimesh.Trimesh(part.vertices, part.faces).split(only_watertight=True):
-        low, high = max(band[0], solid.bounds[0, 2]), min(band[1], solid.bounds[1, 2])
-        if low > high or not solid.is_volume:    # out of the band, or a shell wound inwards
-            continue
-        for z in np.linspace(low, high, levels + 2)[1:-1]:
-            section = solid.section(plane_origin=(0.0, 0.0, z), plane_normal=(0.0, 0.0, 1.0))
-            if section is not None:
-                cuts.append([np.asarray(loop)[:, :2] for loop in section.discrete])
-    return cuts
+        if solid.bounds[1, 2] < band[0] or solid.bounds[0, 2] > band[1] or not solid.is_volume:
+            continue         # out of the band, or a shell wound inwards (a room seen inside)
+        tris = clipped(solid.vertices, solid.faces, band)
+        if len(tris):
+            found.append(tris)
+    return found
+
+
+def _fill_solid(blocked: np.ndarray, tris: np.ndarray, origin, resolution: float) -> None:
+    """Mark in ``blocked`` the cells of one solid's floor outline and everything it
+    encloses (``scipy.ndimage.binary_fill_holes`` in a window around the whole solid,
+    then the part of the window on the grid)."""
+    xy = tris[..., :2].reshape(-1, 2)
+    low = np.floor((xy.min(axis=0) - origin) / resolution).astype(int) - 1
+    high = np.ceil((xy.max(axis=0) - origin) / resolution).astype(int) + 2
+    a, b = np.maximum(low, 0), np.minimum(high, blocked.shape)
+    if np.any(b <= a):
+        return                                  # wholly off the grid
+    window = ndimage.binary_fill_holes(rasterise(list(tris[..., :2]), origin + low * resolution,
+                                                 resolution, tuple(high - low)))
+    blocked[a[0]:b[0], a[1]:b[1]] |= window[a[0] - low[0]:b[0] - low[0],
+                                            a[1] - low[1]:b[1] - low[1]]
 
 
 def clearance_field(parts: tuple[MeshPart, ...], bounds, band) -> ClearanceField | None:
@@ -117,15 +133,15 @@ def clearance_field(parts: tuple[MeshPart, ...], bounds, band) -> ClearanceField
     polygons = [tri[:, :2] for part in colliding for tri in band_triangles(part, band)]
     if not polygons:
         return None
-    solids = [cut for part in colliding for cut in solid_sections(part, band)]
     (xmin, ymin), (xmax, ymax) = bounds
     width, depth = xmax - xmin + 2 * MARGIN, ymax - ymin + 2 * MARGIN
     resolution = max(RESOLUTION, math.sqrt(width * depth / MAX_CELLS))
     shape = (int(math.ceil(width / resolution)) + 1, int(math.ceil(depth / resolution)) + 1)
     origin = np.array([xmin - MARGIN, ymin - MARGIN])
     blocked = rasterise(polygons, origin, resolution, shape)
-    for cut in solids:       # each cut filled on its own: even-odd within it (holes)
-        blocked |= rasterise(cut, origin, resolution, shape)
+    for part in colliding:
+        for tris in solids(part, band):
+            _fill_solid(blocked, tris, origin, resolution)
     distance = ndimage.distance_transform_edt(~blocked) * resolution - resolution
     return ClearanceField(np.maximum(distance, 0.0), (float(origin[0]), float(origin[1])),
                           resolution)
