@@ -11,8 +11,10 @@ configuration, in the same run:
   ``--workers`` processes;
 * ``ratio``: time per env step divided by time per render (1.25 = the env adds 25%).
 
-Worlds: ``arena`` (Yu & Kim's arena, 1,074 triangles) and ``forest10k`` (40 trees as
-64-sided prisms of random size in a walled 10 m square, 10,290 triangles). With
+Worlds: ``arena`` (Yu & Kim's arena, 1,074 triangles), ``forest10k`` (40 trees as
+64-sided prisms of random size in a walled 10 m square, 10,290 triangles) and
+``mesh10k`` (a mesh world: 30 lumpy rocks and four walls of triangles, 9,650 triangles
+and the floor, :func:`mesh_world`). With
 ``raycast`` at 48 x 256 in the arena, physics steps of 1/120 s (``physics_substeps=12``)
 are measured too.
 """
@@ -30,7 +32,7 @@ from tqdm import tqdm
 
 import homing_gym  # noqa: F401  (registers the envs)
 from homing_gym.cli import command_parser
-from homing_gym.scenes import Landmark, Scene, square_walls
+from homing_gym.scenes import Landmark, MeshScene, Scene, square_walls
 
 #: Panorama shapes measured, (H, W) pixels.
 SHAPES = {"48x256": (48, 256), "60x360": (60, 360), "120x720": (120, 720)}
@@ -51,8 +53,36 @@ def forest_scene(trees: int = 40, seed: int = 0) -> Scene:
                  landmarks=tuple(landmarks))
 
 
+def mesh_world(rocks: int = 30, seed: int = 0) -> MeshScene:
+    """A mesh world of about 10,000 triangles: a 10 m square walled by four mesh boxes
+    with ``rocks`` lumpy solids (icospheres of 320 faces, 0.2-0.6 m across, 0.2-1.5 m
+    high, random colours) at least 1 m from the centre."""
+    import trimesh
+
+    rng = np.random.default_rng(seed)
+    meshes, colors = [], []
+    for x, y, ex, ey in ((0, 5.05, 10.2, 0.1), (0, -5.05, 10.2, 0.1), (5.05, 0, 0.1, 10.2),
+                         (-5.05, 0, 0.1, 10.2)):
+        wall = trimesh.creation.box(extents=(ex, ey, 1.0))
+        wall.apply_translation((x, y, 0.5))
+        meshes.append(wall)
+        colors.append(np.full((12, 3), 0.85))
+    while len(meshes) < 4 + rocks:
+        x, y = rng.uniform(-4.4, 4.4, 2)
+        if np.hypot(x, y) > 1.0:
+            rock = trimesh.creation.icosphere(subdivisions=2)
+            rock.vertices *= rng.uniform(0.8, 1.2, (len(rock.vertices), 1))
+            rock.vertices *= [*rng.uniform(0.1, 0.3, 2), rng.uniform(0.1, 0.75)]
+            rock.apply_translation((x, y, -rock.vertices[:, 2].min()))
+            meshes.append(rock)
+            colors.append(np.tile(rng.uniform(0.1, 0.9, 3), (len(rock.faces), 1)))
+    joined = trimesh.util.concatenate(meshes)
+    return MeshScene.from_arrays(joined.vertices, joined.faces, np.concatenate(colors),
+                                 name="mesh10k", bounds=((-5, -5), (5, 5)), fence=False)
+
+
 #: Worlds measured: scene kwargs.
-WORLDS = {"arena": {}, "forest10k": {"scene": forest_scene()}}
+WORLDS = {"arena": {}, "forest10k": {"scene": forest_scene()}, "mesh10k": {"scene": mesh_world()}}
 
 
 def configs(renderers: list[str], shapes: list[str],
@@ -167,7 +197,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--shapes", nargs="+", default=list(SHAPES), choices=list(SHAPES),
                         help="panorama shapes (H x W)")
     parser.add_argument("--worlds", nargs="+", default=["arena"], choices=list(WORLDS),
-                        help="worlds (forest10k: 10,290 triangles)")
+                        help="worlds (forest10k: 10,290 triangles; mesh10k: a mesh world "
+                             "of 9,650 triangles)")
     parser.add_argument("--json", help="also write the results to this JSON file")
     args = parser.parse_args(argv)
     if args.steps < 10 or args.workers < 1:

@@ -189,8 +189,11 @@ def _part(mesh, name: str, collision: bool) -> MeshPart:
     if visual.kind is None:
         face_colors = np.tile(DEFAULT_FACE_COLOR, (len(mesh.faces), 1))
     else:
-        colored = visual.to_color() if visual.kind == "texture" else visual
-        face_colors = np.asarray(colored.face_colors, np.float64)[:, :3] / 255.0
+        from trimesh.visual.color import vertex_to_face_color
+
+        rgba = (vertex_to_face_color(visual.to_color().vertex_colors, mesh.faces)
+                if visual.kind == "texture" else visual.face_colors)
+        face_colors = np.asarray(rgba, np.float64)[:, :3] / 255.0
     return MeshPart(np.asarray(mesh.vertices, np.float64), np.asarray(mesh.faces), face_colors,
                     uvs, texture, collision, name)
 

@@ -9,53 +9,18 @@ import trimesh
 
 from homing_gym.scenes import MeshScene, scene_factory
 from homing_gym.scenes.base import clearance, clearances
+from homing_gym.scenes.mesh_example import (LEG_HALF, PILLAR, example_room_parts,
+                                            write_example_room)
 from homing_gym.topdown import BG, MapCanvas, draw_scene
 from homing_train.harness.rollout import rollout
-
-PILLAR = (-1.0, -0.5, 0.2)             # x, y, radius (metres)
-TABLE_LEGS = [(1.0 + dx, 0.5 + dy) for dx in (0.0, 0.8) for dy in (0.0, 0.6)]
-LEG_HALF = 0.025
-
-
-def _box(extents, centre, rgb):
-    box = trimesh.creation.box(extents=extents)
-    box.apply_translation(centre)
-    box.visual.face_colors = [*rgb, 255]
-    return box
-
-
-def _room_parts() -> dict[str, trimesh.Trimesh]:
-    """A 6 x 4 m room (inner faces at x = +-3, y = +-2), a blue pillar, a table whose top
-    (0.70-0.74 m) is above the robot, and the room's own floor at z = 0."""
-    parts = {
-        "north": _box((6, 0.1, 1.5), (0, 2.05, 0.75), (200, 180, 160)),
-        "south": _box((6, 0.1, 1.5), (0, -2.05, 0.75), (180, 200, 160)),
-        "east": _box((0.1, 4.2, 1.5), (3.05, 0, 0.75), (160, 180, 200)),
-        "west": _box((0.1, 4.2, 1.5), (-3.05, 0, 0.75), (200, 160, 200)),
-        "floor": _box((6, 4, 0.02), (0, 0, -0.01), (120, 120, 120)),
-        "top": _box((0.9, 0.7, 0.04), (1.4, 0.8, 0.72), (140, 90, 40)),
-    }
-    for k, (x, y) in enumerate(TABLE_LEGS):
-        parts[f"leg{k}"] = _box((2 * LEG_HALF, 2 * LEG_HALF, 0.7), (x, y, 0.35), (90, 60, 30))
-    pillar = trimesh.creation.cylinder(radius=PILLAR[2], height=1.5, sections=64)
-    pillar.apply_translation((PILLAR[0], PILLAR[1], 0.75))
-    pillar.visual.face_colors = [20, 60, 200, 255]
-    parts["pillar"] = pillar
-    return parts
 
 
 @pytest.fixture(scope="module")
 def room_files(tmp_path_factory):
-    """The room as one OBJ, one PLY and a GLB with a node per part."""
+    """The example room as one OBJ, one PLY and a GLB with a node per part."""
     folder = tmp_path_factory.mktemp("room")
-    parts = _room_parts()
-    joined = trimesh.util.concatenate(list(parts.values()))
-    joined.export(folder / "room.obj")
-    joined.export(folder / "room.ply")
-    scene = trimesh.Scene()
-    for name, mesh in parts.items():
-        scene.add_geometry(mesh, node_name=name, geom_name=name)
-    scene.export(folder / "room.glb")
+    for name in ("room.obj", "room.ply", "room.glb"):
+        write_example_room(folder / name)
     return folder
 
 
@@ -78,7 +43,7 @@ def test_mesh_file_bounds_and_clearance_match_the_geometry(room_files, name):
 def test_glb_parts_keep_their_names_and_colours(room_files):
     scene = MeshScene.from_file(room_files / "room.glb", no_collision=("pillar",))
     parts = {p.name: p for p in scene.meshes}
-    assert set(parts) == set(_room_parts())
+    assert set(parts) == set(example_room_parts())
     np.testing.assert_allclose(parts["pillar"].face_colors[0], np.array([20, 60, 200]) / 255)
     assert not parts["pillar"].collision and parts["north"].collision
     assert clearance(scene, PILLAR[:2]) > 0.5            # passable when it does not collide
@@ -87,7 +52,7 @@ def test_glb_parts_keep_their_names_and_colours(room_files):
 
 
 def test_mesh_spec_options_scale_and_up_axis(room_files, tmp_path):
-    joined = trimesh.util.concatenate(list(_room_parts().values()))
+    joined = trimesh.util.concatenate(list(example_room_parts().values()))
     y_up = joined.copy()
     y_up.apply_transform(trimesh.transformations.rotation_matrix(-math.pi / 2, (1, 0, 0)))
     y_up.apply_scale(100.0)                                  # centimetres, y up
@@ -191,3 +156,41 @@ def test_bad_mesh_input_is_a_clear_error(tmp_path, room_files, make_env):
                                   bounds=((-1.0, -1.0), (1.0, 1.0)))
     with pytest.raises(ValueError, match="no free space for the robot"):
         make_env(scene=solid)
+
+
+def test_textured_mesh_shows_its_texture_in_the_ray_caster(tmp_path, make_env):
+    """A wall panel whose texture is red on its left half and green on its right: seen
+    face on from 1 m, red fills the panorama columns left of straight ahead."""
+    from PIL import Image
+
+    image = np.zeros((8, 8, 3), np.uint8)
+    image[:, :4] = (220, 20, 20)
+    image[:, 4:] = (20, 200, 20)
+    # a 1 x 0.6 m panel in the plane x = 1, from y = 0.5 (u = 0) to y = -0.5 (u = 1)
+    vertices = [(1, 0.5, 0.0), (1, -0.5, 0.0), (1, -0.5, 0.6), (1, 0.5, 0.6)]
+    uv = [(0, 0), (1, 0), (1, 1), (0, 1)]
+    panel = trimesh.Trimesh(vertices, [(0, 1, 2), (0, 2, 3)], process=False,
+                            visual=trimesh.visual.TextureVisuals(uv=uv, image=Image.fromarray(image)))
+    panel.export(tmp_path / "panel.glb")
+    scene = MeshScene.from_file(tmp_path / "panel.glb", bounds=((-1.5, -1.5), (1.5, 1.5)))
+    assert scene.meshes[0].texture is not None
+    env = make_env(scene=scene, renderer="raycast")
+    obs, _ = env.reset(seed=0, options={"start": (0.0, 0.0, 0.0), "home": (-1.0, 0.0, 0.0)})
+    row = obs["panorama"][obs["panorama"].shape[0] // 2 - 2].astype(int)
+    middle = row.shape[0] // 2
+    left, right = row[middle - 10:middle - 2], row[middle + 2:middle + 10]
+    assert np.all(left[:, 0] > left[:, 1] + 80)         # red left of the heading
+    assert np.all(right[:, 1] > right[:, 0] + 80)       # green right of it
+
+
+def test_benchmark_mesh_world_has_ten_thousand_triangles(make_env):
+    from homing_gym.benchmark import mesh_world
+    from homing_gym.worldmesh import world_mesh
+
+    scene = mesh_world()
+    assert len(world_mesh(scene).triangles) > 9_500
+    env = make_env(scene=scene, renderer="raycast", max_episode_steps=20)
+    env.reset(seed=0)
+    for _ in range(20):
+        _, _, terminated, truncated, info = env.step(env.action_space.sample())
+    assert truncated and not terminated
