@@ -24,7 +24,7 @@ from __future__ import annotations
 import json
 import sys
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass, fields
 
 import gymnasium as gym
 import numpy as np
@@ -188,6 +188,13 @@ def format_table(results: list[BenchmarkResult]) -> str:
     return "\n".join(lines)
 
 
+def _record(result: BenchmarkResult) -> dict:
+    """A result as JSON data (a scene object named by its name)."""
+    kwargs = {k: v.name if isinstance(v, Scene) else v for k, v in result.env_kwargs.items()}
+    return {f.name: getattr(result, f.name) for f in fields(result)} | {
+        "env_kwargs": kwargs, "ratio": result.ratio}
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = command_parser("homing-benchmark", __doc__)
     parser.add_argument("--steps", type=int, default=500, help="steps per measurement")
@@ -208,8 +215,7 @@ def main(argv: list[str] | None = None) -> int:
     print(format_table(results))
     if args.json:
         with open(args.json, "w") as f:
-            json.dump([asdict(r) | {"ratio": r.ratio} for r in results], f, indent=2,
-                      default=lambda scene: scene.name)
+            json.dump([_record(r) for r in results], f, indent=2)
     return 0
 
 

@@ -12,6 +12,7 @@ from homing_gym.scenes.footprint import band_faces
 
 BG = (245, 245, 240)
 WALL = (60, 60, 60)
+FENCE = (170, 170, 170)
 HOME = (30, 150, 60)
 ROBOT = (40, 90, 200)
 PATH = (230, 120, 30)
@@ -37,9 +38,12 @@ class MapCanvas:
 
 
 def draw_scene(scene: Scene, canvas: MapCanvas) -> np.ndarray:
-    """Mesh footprints, walls and landmarks (in their own colours) on a light background,
-    RGB uint8."""
+    """The fence (thin grey), mesh footprints, walls and landmarks (in their own colours)
+    on a light background, RGB uint8."""
     img = np.full((canvas.size, canvas.size, 3), BG, np.uint8)
+    if scene.fence:                       # the invisible boundary, thin
+        (xmin, ymin), (xmax, ymax) = scene.bounds
+        cv2.rectangle(img, canvas.px(xmin, ymax), canvas.px(xmax, ymin), FENCE, 1, cv2.LINE_AA)
     _draw_meshes(img, scene, canvas)
     for wall in scene.walls:
         cv2.line(img, canvas.px(*wall.start), canvas.px(*wall.end), WALL,
@@ -124,7 +128,8 @@ def draw_topdown(scene: Scene, pose, home, trajectory, robot_radius: float = 0.1
     return img
 
 
-def _labelled(image: np.ndarray, label: str, width: int) -> np.ndarray:
+def labelled(image: np.ndarray, label: str, width: int) -> np.ndarray:
+    """``image`` scaled to ``width`` pixels under a bar with ``label``, RGB uint8."""
     scaled = cv2.resize(image, (width, max(1, round(image.shape[0] * width / image.shape[1]))),
                         interpolation=cv2.INTER_NEAREST)
     bar = np.full((22, width, 3), BG, np.uint8)
@@ -137,8 +142,8 @@ def compose_frame(topdown: np.ndarray, panorama: np.ndarray, goal: np.ndarray,
     """The top-down map beside the current and goal panoramas (labelled), RGB uint8."""
     size = topdown.shape[0]
     width = 2 * size
-    right = np.concatenate([_labelled(panorama, "current view " + caption, width),
-                            _labelled(goal, "goal snapshot", width)], axis=0)
+    right = np.concatenate([labelled(panorama, "current view " + caption, width),
+                            labelled(goal, "goal snapshot", width)], axis=0)
     if right.shape[0] < size:
         right = np.concatenate(
             [right, np.full((size - right.shape[0], width, 3), BG, np.uint8)], axis=0)

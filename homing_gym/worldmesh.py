@@ -9,8 +9,10 @@ texture repeats outside ``[0, 1]`` uv). Each triangle has a colour (RGB in
 left to right, ``v`` bottom to top, each box side and the floor covered by its texture
 once, a cylinder's side wrapped once around. The texture colour is multiplied by the
 body colour, as PyBullet does. The triangles of closed solids (boxes, prisms) are wound
-counter-clockwise seen from outside and marked ``closed``: from outside a solid, its
-faces turned away are hidden behind its other faces, so the renderer skips them.
+counter-clockwise seen from outside and marked ``closed``, as are the faces of a mesh
+part's closed solids (:attr:`~homing_gym.scenes.mesh_part.MeshPart.solids`): from outside
+a solid, its faces turned away are hidden behind its other faces, so the renderer skips
+them.
 """
 
 from __future__ import annotations
@@ -149,11 +151,12 @@ class _Builder:
                               inside=centre)
 
     def part(self, part: MeshPart) -> None:
-        """A mesh part's faces, open (never skipped as back faces); a textured part shows
-        its texture alone (its face colours are the texture's, for TinyRenderer)."""
+        """A mesh part's faces (those of its closed solids marked ``closed``); a textured
+        part shows its texture alone (its face colours are the texture's, for
+        TinyRenderer)."""
         tris = part.triangles
         self.tris.extend(tris)
-        self.closed.extend([False] * len(tris))
+        self.closed.extend(part.closed)
         if part.texture is None:
             self.colors.extend(part.face_colors)
             self.tex.extend([-1] * len(tris))

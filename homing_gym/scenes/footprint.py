@@ -92,18 +92,13 @@ def rasterise(polygons: list[np.ndarray], origin, resolution: float,
 
 
 def solids(part: MeshPart, band: tuple[float, float]) -> list[np.ndarray]:
-    """The closed solids of ``part`` in ``band``: for each watertight, outward-wound
-    component (``trimesh`` ``split`` and ``is_volume``), its triangles clipped to the band
-    (:func:`clipped`), if any."""
-    import trimesh
-
+    """The closed solids of ``part`` (:attr:`MeshPart.solids`) that reach into ``band``,
+    each as its triangles clipped to the band (:func:`clipped`)."""
     if len(band_faces(part, band)) == 0:
         return []
     found = []
-    for solid in trimesh.Trimesh(part.vertices, part.faces).split(only_watertight=True):
-        if solid.bounds[1, 2] < band[0] or solid.bounds[0, 2] > band[1] or not solid.is_volume:
-            continue         # out of the band, or a shell wound inwards (a room seen inside)
-        tris = clipped(solid.vertices, solid.faces, band)
+    for faces in part.solids:
+        tris = clipped(part.vertices, part.faces[faces], band)
         if len(tris):
             found.append(tris)
     return found

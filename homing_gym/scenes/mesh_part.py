@@ -11,6 +11,7 @@ into its triangles that reach into the scene's height band
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -71,3 +72,26 @@ class MeshPart:
     def triangles(self) -> np.ndarray:
         """Corners ``(F, 3, 3)`` of every face (metres)."""
         return self.vertices[self.faces]
+
+    @cached_property
+    def solids(self) -> list[np.ndarray]:
+        """Face indices of each closed solid in the part: a connected component that is
+        watertight and wound outwards (``trimesh`` ``is_volume``; a room's inward-wound
+        shell and open surfaces are not). Computed once per part."""
+        import trimesh     # only mesh worlds need it
+
+        mesh = trimesh.Trimesh(self.vertices, self.faces, process=False)
+        mesh.merge_vertices()                  # files often repeat corners per face
+        components = trimesh.graph.connected_components(
+            mesh.face_adjacency, nodes=np.arange(len(self.faces)), min_len=4)
+        return [np.sort(faces) for faces in components
+                if mesh.submesh([faces], append=True).is_volume]
+
+    @property
+    def closed(self) -> np.ndarray:
+        """``(F,)`` bool: the face belongs to one of :attr:`solids` (then its normal, in
+        corner order, points out of the solid)."""
+        mask = np.zeros(len(self.faces), bool)
+        for faces in self.solids:
+            mask[faces] = True
+        return mask

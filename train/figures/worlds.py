@@ -1,0 +1,72 @@
+"""Pictures of the procedural worlds and of a mesh world: for each, a few episodes' worlds
+seen from above (1 m scale bar, the robot's start in blue) beside the ray-cast panorama
+at the start and TinyRenderer's.
+
+``python -m homing_train.figures.worlds --out docs/images/worlds`` writes
+``random_rooms.png``, ``random_nature.png`` and ``mesh_room.png`` (the example room of
+:mod:`homing_gym.scenes.mesh_example`, loaded as ``"mesh:PATH"``).
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+from pathlib import Path
+
+import gymnasium as gym
+import imageio.v2 as imageio
+import numpy as np
+
+import homing_gym  # noqa: F401  (registers the env ids)
+from homing_gym.cli import command_parser
+from homing_gym.scenes.mesh_example import write_example_room
+from homing_gym.topdown import BG, ROBOT, MapCanvas, labelled, draw_pose, draw_scale_bar, draw_scene
+
+PANORAMA = (60, 360)
+
+
+def world_row(scene: str, seed: int, size: int = 240) -> np.ndarray:
+    """The map of episode ``seed``'s world beside both renderers' start panoramas."""
+    views = {}
+    for renderer in ("raycast", "tiny"):
+        env = gym.make("homing_gym/LocalHoming-v0", scene=scene, renderer=renderer,
+                       panorama_shape=PANORAMA)
+        env.reset(seed=seed)
+        u = env.unwrapped
+        views[renderer] = u.render_panorama(u.pose)
+        world, pose = u.scene, u.pose.copy()
+        env.close()
+    canvas = MapCanvas(world, size)
+    top = draw_scene(world, canvas)
+    draw_pose(top, canvas, pose, 0.16, ROBOT)
+    draw_scale_bar(top, canvas, 1.0)
+    right = np.concatenate([labelled(views["raycast"], f"seed {seed}: raycast", 2 * size),
+                            labelled(views["tiny"], "tiny", 2 * size)])
+    height = max(size, right.shape[0])
+    pad = lambda img: np.concatenate([img, np.full((height - img.shape[0], img.shape[1], 3),  # noqa: E731
+                                                   BG, np.uint8)])
+    return np.concatenate([pad(top), pad(right)], axis=1)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = command_parser("python -m homing_train.figures.worlds", __doc__)
+    parser.add_argument("--out", default="docs/images/worlds", help="output folder")
+    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2],
+                        help="episodes of the procedural worlds")
+    args = parser.parse_args(argv)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    for scene in ("random_rooms", "random_nature"):
+        imageio.imwrite(out / f"{scene}.png",
+                        np.concatenate([world_row(scene, seed) for seed in args.seeds]))
+        print(f"wrote {out / scene}.png")
+    with tempfile.TemporaryDirectory() as folder:
+        room = Path(folder) / "room.glb"
+        write_example_room(room)
+        imageio.imwrite(out / "mesh_room.png", world_row(f"mesh:{room}", 0))
+    print(f"wrote {out / 'mesh_room.png'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
