@@ -14,7 +14,7 @@ from homing_gym.native_output import native_output_captured
 with native_output_captured():     # PyBullet's build-time banner goes to the raw stderr
     import pybullet  # noqa: F401
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 #: Registered env ids, with their entry points and step limits.
 _ENVS = {

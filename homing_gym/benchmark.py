@@ -15,8 +15,8 @@ Worlds: ``arena`` (Yu & Kim's arena, 1,074 triangles), ``forest10k`` (40 trees a
 64-sided prisms of random size in a walled 10 m square, 10,290 triangles) and
 ``mesh10k`` (a mesh world: 30 lumpy rocks and four walls of triangles, 9,650 triangles
 and the floor, :func:`mesh_world`). With
-``raycast`` at 48 x 256 in the arena, physics steps of 1/120 s (``physics_substeps=12``)
-are measured too.
+``tiny`` at 48 x 256 in the arena, homing-gym 0.1's default physics steps of 1/240 s
+(``physics_substeps=24``) are measured too.
 """
 
 from __future__ import annotations
@@ -87,9 +87,9 @@ WORLDS = {"arena": {}, "forest10k": {"scene": forest_scene()}, "mesh10k": {"scen
 
 def configs(renderers: list[str], shapes: list[str],
             worlds: list[str] = ("arena",)) -> dict[str, dict]:
-    """Env kwargs of each measured configuration, named ``RENDERER HxW [WORLD]``; with
-    ``raycast`` at 48 x 256 in the arena also ``raycast 48x256 1/120 s`` (physics steps of
-    1/120 s instead of 1/240 s)."""
+    """Env kwargs of each measured configuration, named ``RENDERER HxW [WORLD]`` (the
+    default physics, steps of 1/120 s); with ``tiny`` at 48 x 256 in the arena also
+    ``tiny 48x256 1/240 s``, homing-gym 0.1's default env."""
     out = {}
     for world in worlds:
         suffix = "" if world == "arena" else f" {world}"
@@ -97,9 +97,9 @@ def configs(renderers: list[str], shapes: list[str],
             for r in renderers:
                 out[f"{r} {s}{suffix}"] = {"renderer": r, "panorama_shape": SHAPES[s],
                                            **WORLDS[world]}
-                if (r, s, world) == ("raycast", "48x256", "arena"):
-                    out["raycast 48x256 1/120 s"] = {"renderer": r, "panorama_shape": SHAPES[s],
-                                                     "physics_substeps": 12}
+                if (r, s, world) == ("tiny", "48x256", "arena"):
+                    out["tiny 48x256 1/240 s"] = {"renderer": r, "panorama_shape": SHAPES[s],
+                                                  "physics_substeps": 24}
     return out
 
 

@@ -173,14 +173,53 @@ def cast_columns(tris: np.ndarray, normals: np.ndarray, closed: np.ndarray,
 
 
 @njit(cache=True, error_model="numpy")
+def _texel(atlas: np.ndarray, levels: np.ndarray, m: int, s: float, v: float,
+           out: np.ndarray) -> None:
+    """Bilinear sample (wrapped) of mip level ``levels[m] = (offset, height, width)`` at
+    texture coordinates ``(s, v)`` (``v`` bottom to top) into ``out (3,)``."""
+    off, h, w = levels[m, 0], levels[m, 1], levels[m, 2]
+    x = (s - math.floor(s)) * w - 0.5                # in [-0.5, w - 0.5)
+    y = (math.ceil(v) - v) * h - 0.5                 # rows run top to bottom
+    xa, ya = int(math.floor(x)), int(math.floor(y))  # in [-1, w - 1], [-1, h - 1]
+    fx, fy = x - xa, y - ya
+    xb, yb = xa + 1, ya + 1
+    if xa < 0:
+        xa += w
+    if xb >= w:
+        xb -= w
+    if ya < 0:
+        ya += h
+    if yb >= h:
+        yb -= h
+    a, b = off + 3 * (ya * w + xa), off + 3 * (ya * w + xb)
+    c_, d = off + 3 * (yb * w + xa), off + 3 * (yb * w + xb)
+    for c in range(3):
+        top = (1 - fx) * atlas[a + c] + fx * atlas[b + c]
+        bottom = (1 - fx) * atlas[c_ + c] + fx * atlas[d + c]
+        out[c] = (1 - fy) * top + fy * bottom
+
+
+@njit(cache=True, error_model="numpy")
 def shade(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.ndarray,
-          uvs: np.ndarray, atlas: np.ndarray, tex_shape: np.ndarray, sky: np.ndarray,
-          out: np.ndarray) -> None:
+          uvs: np.ndarray, atlas: np.ndarray, levels: np.ndarray, first_level: np.ndarray,
+          texel_density: np.ndarray, tris: np.ndarray, normals: np.ndarray,
+          origin: np.ndarray, ray_spacing: float, sky: np.ndarray, out: np.ndarray) -> None:
     """Colour per pixel (``out (H, W, 3)`` in ``[0, 1]``): ``sky`` where nothing was hit,
-    else the triangle's lit colour ``base`` times its texture's nearest texel (``u`` left
-    to right, ``v`` bottom to top, wrapped), clipped. ``atlas`` holds every texture's
-    pixels flattened one after another; ``tex_shape[k] = (offset, height, width)``."""
+    else the triangle's lit colour ``base`` times its texture (``u`` left to right, ``v``
+    bottom to top, wrapped), clipped.
+
+    Textures are filtered like a camera's pixel (trilinear mip-mapping): the ray's
+    footprint on the surface, ``r * ray_spacing / |cos(incidence)|`` metres (``r`` the
+    ray's length, ``ray_spacing`` the angle between neighbouring rays, radians; the cosine
+    at least 0.1), times the triangle's ``texel_density`` (texels per metre at full
+    resolution) gives the level of detail ``log2`` of that many texels; the two mip levels
+    around it are sampled bilinearly and blended. ``atlas`` holds every level of every
+    texture flattened one after another; ``levels[m] = (offset, height, width)`` of mip
+    level ``m``, texture ``k``'s levels from ``first_level[k]`` to ``first_level[k + 1]``
+    (full resolution first, each half the size of the one before). A face whose UVs cover
+    no area (one texel for the whole face) takes that texel."""
     H, W = hit.shape
+    near, far = np.empty(3), np.empty(3)
     for i in range(H):
         for j in range(W):
             t = hit[i, j]
@@ -191,14 +230,38 @@ def shade(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.nd
             k = texture[t]
             if k >= 0:
                 s = v = 0.0
+                px = py = pz = 0.0
                 for c in range(3):
                     s += weights[i, j, c] * uvs[t, c, 0]
                     v += weights[i, j, c] * uvs[t, c, 1]
-                off, h, w = tex_shape[k, 0], tex_shape[k, 1], tex_shape[k, 2]
-                col = min(max(int((s % 1.0) * w), 0), w - 1)
-                row = min(max(int((1.0 - v % 1.0) * h), 0), h - 1)
-                at = off + 3 * (row * w + col)
-                r, g, b = r * atlas[at], g * atlas[at + 1], b * atlas[at + 2]
+                    px += weights[i, j, c] * tris[t, c, 0]
+                    py += weights[i, j, c] * tris[t, c, 1]
+                    pz += weights[i, j, c] * tris[t, c, 2]
+                dx, dy, dz = px - origin[0], py - origin[1], pz - origin[2]
+                length = math.sqrt(dx * dx + dy * dy + dz * dz)
+                facing = abs(normals[t, 0] * dx + normals[t, 1] * dy + normals[t, 2] * dz)
+                cos_in = max(facing / max(length, 1e-9), 0.1)
+                texels = length * ray_spacing / cos_in * texel_density[t]
+                lod = math.log2(texels) if texels > 1.0 else 0.0
+                top = first_level[k + 1] - first_level[k] - 1
+                lod = min(lod, float(top))
+                m = int(lod)
+                frac = lod - m
+                base_level = first_level[k]
+                if texel_density[t] == 0.0:      # one texel spread over the face (no UVs)
+                    off, h, w = (levels[base_level, 0], levels[base_level, 1],
+                                 levels[base_level, 2])
+                    col = min(max(int((s % 1.0) * w), 0), w - 1)
+                    row = min(max(int((1.0 - v % 1.0) * h), 0), h - 1)
+                    for c in range(3):
+                        near[c] = atlas[off + 3 * (row * w + col) + c]
+                else:
+                    _texel(atlas, levels, base_level + m, s, v, near)
+                if frac > 0.0 and m < top and texel_density[t] > 0.0:
+                    _texel(atlas, levels, base_level + m + 1, s, v, far)
+                    for c in range(3):
+                        near[c] = (1 - frac) * near[c] + frac * far[c]
+                r, g, b = r * near[0], g * near[1], b * near[2]
             out[i, j, 0] = min(max(r, 0.0), 1.0)
             out[i, j, 1] = min(max(g, 0.0), 1.0)
             out[i, j, 2] = min(max(b, 0.0), 1.0)

@@ -44,8 +44,17 @@ MIN_TIME_STEP, MAX_TIME_STEP = 1 / 2000, 1 / 60
 #: Observation keys the env core provides (tasks may add more): see
 #: :mod:`homing_gym.observations`.
 OBSERVATION_KEYS = (*CORE_KEYS, "goal_step")
+#: Physics sub-steps per control period by default (1/120 s at the default 0.1 s).
+PHYSICS_SUBSTEPS = 12
 #: Grid (metres) on which a new world is checked for room for the robot.
 ROOM_RESOLUTION = 0.05
+
+
+def simulation_settings(env_kwargs: dict) -> dict:
+    """The renderer and physics sub-steps an env made with ``env_kwargs`` runs with (the
+    given ones, else the defaults): what result files record beside the policy."""
+    return {"renderer": env_kwargs.get("renderer", CameraConfig.renderer),
+            "physics_substeps": env_kwargs.get("physics_substeps", PHYSICS_SUBSTEPS)}
 
 
 def _check_room(scene: Scene, radius: float) -> None:
@@ -74,7 +83,7 @@ class HomingEnv(gym.Env):
                  omni_size: int = CameraConfig.omni_size,
                  supersampling: int = CameraConfig.supersampling,
                  action_type: str = "continuous", control_period: float = 0.1,
-                 physics_substeps: int = 24, max_speed: float = RobotConfig.max_speed,
+                 physics_substeps: int = PHYSICS_SUBSTEPS, max_speed: float = RobotConfig.max_speed,
                  max_yaw_rate: float = RobotConfig.max_yaw_rate, stop_threshold: float = 0.05,
                  odometry_noise: float = 0.02, odometry_origin: str = "start",
                  lighting_change: float = 0.0, goal_step_length: float = 0.15,

@@ -39,9 +39,9 @@ class LocalHomingEnv(HomingEnv):
     speeds at up to 2 m/s^2 of rim acceleration (``RobotConfig.wheel_acceleration``), so
     full speed is reached within about 0.15 s. With ``action_type="discrete"``: ``Discrete(4)``,
     0 forward at full speed, 1 turn left, 2 turn right, 3 stop. Each action is held for one
-    control period of ``control_period`` = 0.1 s, simulated in ``physics_substeps`` = 24
-    physics steps of 1/240 s (12, steps of 1/120 s, still pass the motion tests and
-    halve the physics time; 8 lost 11 % of the forward speed).
+    control period of ``control_period`` = 0.1 s, simulated in ``physics_substeps`` = 12
+    physics steps of 1/120 s (homing-gym 0.1 used 24 steps of 1/240 s: the motion tests
+    pass with both, 12 halve the physics time; 8 lost 11 % of the forward speed).
 
     ## Observation space
 
@@ -106,10 +106,10 @@ class LocalHomingEnv(HomingEnv):
     ``"random_arena"`` or a :class:`~homing_gym.scenes.Scene`), ``render_mode``
     (``None``, ``"rgb_array"``: top-down map beside current and goal panoramas;
     ``"human"``: PyBullet GUI), ``obs_keys``, ``panorama_shape`` = (48, 256),
-    ``vfov_deg`` = 60, ``n_views`` = 6, ``renderer`` = ``"tiny"`` (PyBullet's
-    TinyRenderer, six perspective views remapped; ``"raycast"``: exact ray casting through
-    the pixels, 3-4x faster, see :mod:`homing_gym.raycast`; ``"egl"``: PyBullet's OpenGL
-    plugin),
+    ``vfov_deg`` = 60, ``n_views`` = 6, ``renderer`` = ``"raycast"`` (exact ray
+    casting through the pixels, textures filtered like a camera's pixels, see
+    :mod:`homing_gym.raycast`; ``"tiny"``: PyBullet's TinyRenderer, six perspective views
+    remapped, homing-gym 0.1's default, 2-6x slower; ``"egl"``: PyBullet's OpenGL plugin),
     ``supersampling`` = 2 (raycast: ``k x k`` rays averaged per panorama pixel, 1-4), ``omni_size`` = 128,
     ``action_type``, ``control_period`` (at most 2 s), ``physics_substeps`` (1-1000; each
     physics step between 1/2000 and 1/60 s), ``max_speed``,

@@ -21,11 +21,12 @@ Conventions (tested in ``tests/homing_gym/test_panorama.py``):
   the luminance in ``[0, 1]`` averaged over ``signature_rows`` samples spaced one row apart
   and centred on the horizon (linear interpolation between rows).
 
-The panorama is rendered by PyBullet from ``n_views`` perspective cameras at the camera
-centre, facing evenly spaced yaws, and resampled into the cylinder with a single
-precomputed ``cv2.remap``. TinyRenderer (CPU, default) and EGL (GPU) give the same
-geometry; their shading and background colour differ, so do not mix them between
-training and evaluation.
+By default (``renderer="raycast"``) the panorama is ray cast directly
+(:mod:`homing_gym.raycast`). With ``"tiny"`` or ``"egl"`` it is rendered by PyBullet from
+``n_views`` perspective cameras at the camera centre, facing evenly spaced yaws, and
+resampled into the cylinder with a single precomputed ``cv2.remap``. The renderers give
+the same geometry; their shading and background colour differ, so do not mix them
+between training and evaluation (result files record the renderer).
 """
 
 from __future__ import annotations
@@ -83,7 +84,7 @@ class CameraConfig:
     far: float = 30.0
     omni_size: int = 128
     signature_rows: int = 5
-    renderer: str = "tiny"
+    renderer: str = "raycast"
     supersampling: int = 2
 
     def __post_init__(self) -> None:

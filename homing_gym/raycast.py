@@ -7,8 +7,13 @@ column ``j`` (centre ``j + 0.5``) has bearing ``pi - 2*pi*(j + 0.5)/W``
 counter-clockwise from the heading, row ``i`` the elevation
 ``vfov/2 - vfov*(i + 0.5)/H``; no resampling. Perspective rays are those of an upright
 pinhole with square pixels (:class:`~homing_gym.perspective.PerspectiveConfig`), through
-pixel centres. Shading: the triangle's colour, times its texture (nearest texel) if it has
-one, times ``ambient + diffuse * max(0, n . l)`` (Lambert with the
+pixel centres. Shading: the triangle's colour, times its texture if it has one (filtered
+over a pixel's footprint by trilinear mip-mapping, as a camera pixel integrates light:
+:func:`homing_gym.column_cast.shade`; each of a pixel's ``k x k`` rays filters over the
+whole pixel, so their mean covers about a pixel and a half, like a pixel seen through
+its lens' blur; with nearest texels distant textures aliased, and with each ray filtering
+only its ``1/k`` share Hong's route following still lost targets on some seeds:
+``docs/benchmark.md``), times ``ambient + diffuse * max(0, n . l)`` (Lambert with the
 :class:`~homing_gym.panorama.Lighting` direction ``l``, ``n`` the face's normal on the
 side the camera sees: a face turned away from the light gets the ambient term alone, as
 in TinyRenderer, so walls of different orientation differ in brightness), clipped, then
@@ -68,6 +73,36 @@ def perspective_rays(width: int, height: int, focal: float, k: int = 1):
     return np.arctan(left), up[:, None] / np.sqrt(1 + left[None, :] ** 2)
 
 
+def mip_levels(texture: np.ndarray) -> list[np.ndarray]:
+    """The mip pyramid of a texture (float RGB): full resolution, then each level the box
+    average of the one before at half the size (``cv2.INTER_AREA``), down to one texel."""
+    levels = [np.ascontiguousarray(texture, np.float32)]
+    while max(levels[-1].shape[:2]) > 1:
+        h, w = levels[-1].shape[:2]
+        levels.append(cv2.resize(levels[-1], (max(1, w // 2), max(1, h // 2)),
+                                 interpolation=cv2.INTER_AREA).reshape(max(1, h // 2),
+                                                                       max(1, w // 2), 3))
+    return levels
+
+
+def texel_density(mesh: WorldMesh) -> np.ndarray:
+    """Texels per metre of each triangle's texture at full resolution (``(N,)``; 0 for
+    untextured triangles): the square root of the texels its UVs cover over its area."""
+    density = np.zeros(len(mesh.triangles))
+    textured = np.flatnonzero(mesh.texture >= 0)
+    if len(textured) == 0:
+        return density
+    tris = mesh.triangles[textured].astype(np.float64)
+    area = 0.5 * np.linalg.norm(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), axis=1)
+    uv = mesh.uvs[textured].astype(np.float64)
+    e1, e2 = uv[:, 1] - uv[:, 0], uv[:, 2] - uv[:, 0]
+    uv_area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    sizes = np.array([t.shape[0] * t.shape[1] for t in mesh.textures], np.float64)
+    texels = uv_area * sizes[mesh.texture[textured]]
+    density[textured] = np.sqrt(texels / np.maximum(area, 1e-12))
+    return density
+
+
 class RayCaster:
     """Casts and shades rays in one world mesh; rebuilt when the world changes."""
 
@@ -83,13 +118,16 @@ class RayCaster:
         self._closed = mesh.closed.astype(np.bool_)
         self._uvs = mesh.uvs.astype(np.float64)
         self._texture = mesh.texture.astype(np.int64)
-        sizes = [t.size for t in mesh.textures]
-        offsets = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
-        self._atlas = (np.concatenate([t.ravel() for t in mesh.textures]).astype(np.float64)
-                       if mesh.textures else np.zeros(3))
-        self._tex_shape = np.array([(o, t.shape[0], t.shape[1])
-                                    for o, t in zip(offsets, mesh.textures)],
-                                   np.int64).reshape(-1, 3)
+        pyramids = [mip_levels(t) for t in mesh.textures]
+        images = [level for pyramid in pyramids for level in pyramid]
+        offsets = np.concatenate([[0], np.cumsum([i.size for i in images])[:-1]]).astype(np.int64)
+        self._atlas = (np.concatenate([i.ravel() for i in images]).astype(np.float32)
+                       if images else np.zeros(3, np.float32))
+        self._levels = np.array([(o, i.shape[0], i.shape[1]) for o, i in zip(offsets, images)],
+                                np.int64).reshape(-1, 3)
+        self._first_level = np.concatenate(
+            [[0], np.cumsum([len(p) for p in pyramids])]).astype(np.int64)
+        self._texel_density = texel_density(mesh)
 
     def _lit_colors(self, lighting: Lighting, origin: np.ndarray) -> np.ndarray:
         """Each triangle's colour times ``ambient + diffuse * max(0, n . l)`` seen from
@@ -100,7 +138,7 @@ class RayCaster:
                              * np.sign(towards), 0.0)
         return self.mesh.colors * (lighting.ambient + lighting.diffuse * lambert)[:, None]
 
-    def _image(self, pose, camera_height: float, rays, k: int,
+    def _image(self, pose, camera_height: float, rays, k: int, spacing: float,
                lighting: Lighting | None) -> np.ndarray:
         beta, tan_elev = rays
         x, y, yaw = (float(v) for v in pose)
@@ -112,7 +150,8 @@ class RayCaster:
                      hit, weights)
         colors = np.empty((H, W, 3))
         shade(hit, weights, self._lit_colors(lighting or DEFAULT_LIGHTING, origin), self._texture,
-              self._uvs, self._atlas, self._tex_shape, self.sky, colors)
+              self._uvs, self._atlas, self._levels, self._first_level, self._texel_density,
+              self._tris, self._normals, origin, spacing, self.sky, colors)
         if k > 1:   # the mean of each pixel's k x k samples (INTER_AREA: box average)
             colors = cv2.resize(colors.astype(np.float32), (W // k, H // k),
                                 interpolation=cv2.INTER_AREA)
@@ -123,11 +162,14 @@ class RayCaster:
         """The cylindrical panorama (uint8 ``(H, W, 3)``) at ``pose = (x, y, yaw)``;
         ``supersampling`` defaults to ``config.supersampling``."""
         k = config.supersampling if supersampling is None else supersampling
-        rays = panorama_rays(tuple(config.panorama_shape), config.vfov, k)
-        return self._image(pose, camera_height, rays, k, lighting)
+        H, W = config.panorama_shape
+        rays = panorama_rays((H, W), config.vfov, k)
+        # each ray filters the texture over a whole pixel (see :func:`shade`'s caller note)
+        spacing = max(2 * np.pi / W, config.vfov / H)
+        return self._image(pose, camera_height, rays, k, spacing, lighting)
 
     def perspective(self, pose, camera_height: float, width: int, height: int, focal: float,
                     lighting: Lighting | None = None, supersampling: int = 1) -> np.ndarray:
         """A pinhole view (uint8 ``(height, width, 3)``) along the heading at ``pose``."""
         rays = perspective_rays(width, height, float(focal), supersampling)
-        return self._image(pose, camera_height, rays, supersampling, lighting)
+        return self._image(pose, camera_height, rays, supersampling, 1.0 / focal, lighting)

@@ -6,7 +6,7 @@ state. The world is built once; :meth:`Simulator.reset_world` restores a saved s
 (``saveState``/``restoreState``) instead of reloading URDFs. Only a randomised scene that
 changes its landmarks rebuilds those primitive bodies (no URDF loading).
 
-Physics: ``time_step`` (default 1/240 s) per ``stepSimulation``; the env runs
+Physics: ``time_step`` (the env's default 1/120 s) per ``stepSimulation``; the env runs
 ``substeps`` of them per control period.
 """
 
@@ -46,8 +46,8 @@ def _fixed_part(scene: Scene) -> tuple:
 class Simulator:
     """One PyBullet client holding a scene and the robot."""
 
-    def __init__(self, scene: Scene, *, gui: bool = False, time_step: float = 1 / 240,
-                 robot_config: RobotConfig = RobotConfig(), renderer: str = "tiny",
+    def __init__(self, scene: Scene, *, gui: bool = False, time_step: float = 1 / 120,
+                 robot_config: RobotConfig = RobotConfig(), renderer: str = "raycast",
                  sky_color: tuple[float, float, float] | None = None):
         with native_output_captured():    # the C++ core prints "argv[0]=" on connecting
             self.client = BulletClient(connection_mode=p.GUI if gui else p.DIRECT)

@@ -13,9 +13,9 @@ bilinear interpolation, less one cell size, so it never claims more room than th
 component wound outwards: a pillar, a rock) is blocked too: the floor outline of its
 triangles in the band is filled (``scipy.ndimage.binary_fill_holes``; a solid with a hole
 through it, a ring, is filled whole); an inward-wound shell (a room modelled as one box
-seen from inside) and open surfaces block only along their faces. The same clipped triangles become the
-PyBullet collision body (:mod:`homing_gym.simulator`), so what the planner avoids is
-what the robot bumps into.
+seen from inside) and open surfaces block only along their faces. The same triangles
+(those reaching into the band) become the PyBullet collision body
+(:mod:`homing_gym.simulator`), so what the planner avoids is what the robot bumps into.
 """
 
 from __future__ import annotations

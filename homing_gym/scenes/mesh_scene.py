@@ -117,7 +117,8 @@ class MeshScene(Scene):
                     **options) -> "MeshScene":
         """One mesh of ``vertices`` ``(V, 3)`` and ``faces`` ``(F, 3)``; ``colors``: RGB
         in [0, 1] per face ``(F, 3)`` or per vertex ``(V, 3)`` (a face takes the mean of
-        its corners; with as many vertices as faces, per face), or ``None`` (grey). Options as in :meth:`from_parts`."""
+        its corners; with as many vertices as faces, per face), or ``None`` (grey).
+        Options as in :meth:`from_parts`."""
         vertices, faces = np.asarray(vertices, np.float64), np.asarray(faces)
         face_colors = np.tile(DEFAULT_FACE_COLOR, (len(faces), 1))
         if colors is not None:
@@ -145,7 +146,8 @@ class MeshScene(Scene):
         return cls.from_parts(parts, **options)
 
 
-def load_parts(path, *, collision: bool = True, no_collision: tuple[str, ...] = ()) -> list[MeshPart]:
+def load_parts(path, *, collision: bool = True,
+               no_collision: tuple[str, ...] = ()) -> list[MeshPart]:
     """The :class:`MeshPart` of each geometry in the file at ``path`` (see
     :meth:`MeshScene.from_file`)."""
     import trimesh      # imported here: only mesh worlds need its loaders

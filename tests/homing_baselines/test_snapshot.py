@@ -8,6 +8,9 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
+from homing_train.harness.evaluate import run_episode
+from homing_train.harness.rollout import prepare_policy
+
 import homing_baselines
 from homing_baselines.motion import MotionSpec
 from homing_baselines.signature import (bearing_grid, characteristic_points, monotonic_segments,
@@ -151,17 +154,31 @@ def test_registered_and_needs_its_observation_keys():
         homing_baselines.make("snapshot", source="omni").decide({"panorama": np.zeros((60, 360, 3))})
 
 
-def test_stops_then_restarts_when_the_goal_changes(hallway_views):
-    """At the goal itself the direction flips between decisions (no offsets); once
-    stopped it stays stopped until the goal snapshot changes."""
+def test_started_at_home_it_stops_near_home(make_env):
+    """§4's stop rule at the goal itself: the first step (0.6 ft) leaves home, the next
+    estimate points back (the direction reverses), and the robot stops there, about one
+    first step away (so not within the 0.15 m radius: the method stops after the
+    overshoot it detects)."""
+    env = make_env(scene="hallway", panorama_shape=PANORAMA, success_on="stop",
+                   max_episode_steps=200)
+    for seed in (3, 4, 5):
+        env.reset(seed=seed)
+        home = env.unwrapped.episode.home
+        c = SnapshotController()
+        prepare_policy(c, env)
+        record = run_episode(env, c, seed, start=home, home=home)
+        assert record.terminated and not record.truncated
+        assert record.final_distance < 0.6 * 0.3048 + 0.02, (seed, record.final_distance)
+        assert record.steps < 60
+
+
+def test_stays_stopped_until_the_goal_changes(hallway_views):
     c = SnapshotController()
     c.configure(MotionSpec())
     c.reset(0)
     pano = hallway_views["panorama"]
-    moves = [c.decide({"panorama": pano, "goal": pano}) for _ in range(6)]
-    assert moves[0] is not None and any(m is None for m in moves)
-    first_stop = next(i for i, m in enumerate(moves) if m is None)
-    assert all(m is None for m in moves[first_stop:])
+    c._stopped, c._goal = True, pano.copy()      # as after the stop rule fired
+    assert all(c.decide({"panorama": pano, "goal": pano}) is None for _ in range(3))
     shifted = np.roll(pano, 20, axis=1)
     move = c.decide({"panorama": pano, "goal": shifted})
     assert move is not None and move.distance == pytest.approx(0.6 * 0.3048)

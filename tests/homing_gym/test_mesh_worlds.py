@@ -169,8 +169,8 @@ def test_textured_mesh_shows_its_texture_in_the_ray_caster(tmp_path, make_env):
     # a 1 x 0.6 m panel in the plane x = 1, from y = 0.5 (u = 0) to y = -0.5 (u = 1)
     vertices = [(1, 0.5, 0.0), (1, -0.5, 0.0), (1, -0.5, 0.6), (1, 0.5, 0.6)]
     uv = [(0, 0), (1, 0), (1, 1), (0, 1)]
-    panel = trimesh.Trimesh(vertices, [(0, 1, 2), (0, 2, 3)], process=False,
-                            visual=trimesh.visual.TextureVisuals(uv=uv, image=Image.fromarray(image)))
+    visual = trimesh.visual.TextureVisuals(uv=uv, image=Image.fromarray(image))
+    panel = trimesh.Trimesh(vertices, [(0, 1, 2), (0, 2, 3)], process=False, visual=visual)
     panel.export(tmp_path / "panel.glb")
     scene = MeshScene.from_file(tmp_path / "panel.glb", bounds=((-1.5, -1.5), (1.5, 1.5)))
     assert scene.meshes[0].texture is not None

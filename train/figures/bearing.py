@@ -55,6 +55,7 @@ from homing_baselines.bearing_laws import LAWS  # noqa: E402
 from homing_baselines.bearing_sim import (ReachabilityMap, SimConfig, circumcircle,  # noqa: E402
                                    reachability_map, region)
 from homing_gym.cli import command_parser  # noqa: E402
+from homing_train.figures import MEASURED_WITH  # noqa: E402
 
 #: The landmark triangle of the figures (m): scalene, about 2 m a side.
 LANDMARKS = np.array([[-1.0, -0.6], [1.2, -0.5], [0.2, 1.1]])
@@ -260,7 +261,7 @@ def lab_env(max_steps: int):
 
     gym.register_envs(homing_gym)
     return gym.make("homing_gym/LocalHoming-v0", scene="lab", success_on="stop",
-                    max_episode_steps=max_steps)
+                    max_episode_steps=max_steps, **MEASURED_WITH)
 
 
 def _cell(run: dict, fail_cm: float) -> str:
@@ -435,7 +436,7 @@ def longrange(out: str, episodes: int = 10, seed: int = 0, route_length: float =
 
     gym.register_envs(homing_gym)
     env = gym.make("homing_gym/LongRangeHoming-v0", route_length=route_length,
-                   success_on="stop")
+                   success_on="stop", **MEASURED_WITH)
     os.makedirs(out, exist_ok=True)
     rows: list[dict] = []
     for s in tqdm(range(seed, seed + episodes), desc="long-range episodes",

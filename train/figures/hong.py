@@ -30,6 +30,7 @@ from homing_gym.cli import command_parser
 from homing_gym.geometry import bearing_to, wrap_angle
 from homing_gym.scenes.base import clearance
 from homing_train.harness.evaluate import evaluate
+from homing_train.figures import MEASURED_WITH
 from homing_train.harness.rollout import prepare_policy, rollout
 from homing_train.harness.field import homing_field, plot_field
 from homing_train.harness.policies import policy_spec
@@ -71,7 +72,7 @@ class PairSet:
 
 def render_pairs(scene: str, distance: float, n: int, seed: int = 0) -> PairSet:
     """``n`` random pairs with at least 0.25 m clearance in ``scene``."""
-    env = gym.make(LOCAL, scene=scene, panorama_shape=PANORAMA)
+    env = gym.make(LOCAL, scene=scene, panorama_shape=PANORAMA, **MEASURED_WITH)
     try:
         env.reset(seed=seed)
         u = env.unwrapped
@@ -127,7 +128,7 @@ def plot_signature(out: str, seed: int = 3) -> dict[str, Any]:
     from homing_baselines.signature import characteristic_points, signature_from_omni, \
         signature_from_panorama
 
-    env = gym.make(LOCAL, scene="hallway", panorama_shape=PANORAMA, omni_size=256,
+    env = gym.make(LOCAL, scene="hallway", panorama_shape=PANORAMA, omni_size=256, **MEASURED_WITH,
                    obs_keys=("panorama", "omni"))
     obs, _ = env.reset(seed=seed)
     env.close()
@@ -160,7 +161,8 @@ def run_fields(out: str, names: list[str], seed: int = 0) -> dict[str, Any]:
     res = {}
     for name in names:
         for scene in ("arena", "hallway"):
-            kw = {"scene": scene, "panorama_shape": PANORAMA, "success_on": "stop"}
+            kw = {"scene": scene, "panorama_shape": PANORAMA, "success_on": "stop",
+                  **MEASURED_WITH}
             field = homing_field(policy_spec(name), LOCAL, grid=0.2 if scene == "arena" else 0.3,
                                  seed=seed, env_kwargs=kw)
             path = os.path.join(out, f"field_{name}_{scene}.png")
@@ -176,7 +178,7 @@ def run_eval(names: list[str], episodes: int = 200) -> dict[str, Any]:
     res = {}
     for name in names:
         for label, extra in (("default", {}), ("far", {"start_distance": (1.5, 2.5)})):
-            kw = {"panorama_shape": PANORAMA, "success_on": "stop", **extra}
+            kw = {"panorama_shape": PANORAMA, "success_on": "stop", **MEASURED_WITH, **extra}
             try:
                 r = evaluate(name, LOCAL, episodes=episodes, seed=0, env_kwargs=kw)
             except ValueError as err:      # a start distance that cannot fit the arena
@@ -200,7 +202,8 @@ def run_routes(names: list[str], episodes: int = 20,
     res = {}
     for name in names:
         for light in (0.0, 0.5):
-            kw = {"panorama_shape": PANORAMA, "success_on": "stop", "lighting_change": light,
+            kw = {"panorama_shape": PANORAMA, "success_on": "stop", **MEASURED_WITH,
+                  "lighting_change": light,
                   "drive": drive}
             if drive == "synchro":
                 kw["start_jitter"] = (0.05, 0.0)

@@ -33,6 +33,7 @@ from homing_baselines.multires_localise import localise
 from homing_gym.cli import command_parser
 from homing_gym.scenes.base import clearance
 from homing_gym.teaching import FeatureMap
+from homing_train.figures import MEASURED_WITH
 from homing_train.harness.rollout import prepare_policy, rollout
 
 ENV_ID = "homing_gym/WorkLocations-v0"
@@ -60,7 +61,7 @@ def localisation_experiment(daily_changes: float, spacing: float, headings: int,
     rows = []
     gym.register_envs(homing_gym)
     for name in LOCATIONS:
-        env = gym.make(ENV_ID, goal_location=name, daily_changes=daily_changes)
+        env = gym.make(ENV_ID, goal_location=name, daily_changes=daily_changes, **MEASURED_WITH)
         obs, _ = env.reset(seed=seed)
         fmap, u = _feature_map(obs), env.unwrapped
         for dx, dy in grid_offsets(0.5, spacing):
@@ -103,7 +104,7 @@ def summarise_localisation(rows: list[dict]) -> dict:
 
 def travel_experiment(episodes: int, seed: int, daily_changes: float) -> list[dict]:
     gym.register_envs(homing_gym)
-    env = gym.make(ENV_ID, daily_changes=daily_changes)
+    env = gym.make(ENV_ID, daily_changes=daily_changes, **MEASURED_WITH)
     controller = homing_baselines.make("multires")
     prepare_policy(controller, env)
     rows = []

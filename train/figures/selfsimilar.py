@@ -49,6 +49,7 @@ import numpy as np
 from homing_baselines.camera_models import PerspectiveModel
 from homing_baselines.selfsimilar_detector import DetectorConfig, detect_landmarks
 from homing_gym.cli import command_parser
+from homing_train.figures import MEASURED_WITH
 
 #: Frames per second reported by the paper (§3.3) with the speed-ups.
 PAPER_FPS = {(640, 480): 36.0, (320, 240): 81.0}
@@ -65,7 +66,7 @@ def render_views(sizes: Sequence[tuple[int, int]]) -> dict[tuple, np.ndarray]:
     import homing_gym
 
     gym.register_envs(homing_gym)
-    env = gym.make("homing_gym/LandmarkNavigation-v0")
+    env = gym.make("homing_gym/LandmarkNavigation-v0", **MEASURED_WITH)
     env.reset(seed=0)
     try:
         return {(size, name): env.unwrapped.render_view(pose, size=size, hfov_deg=60)
@@ -147,7 +148,8 @@ def _one_panel_env(contrast: float, occluded: float):
                                   name="occluder"))
     scene = Scene("one_panel", ((-3, -3), (3, 3)), walls=square_walls(6.0, height=1.2),
                   landmarks=tuple(landmarks))
-    env = gym.make("homing_gym/LocalHoming-v0", scene=scene, start_distance=(0.3, 1.0))
+    env = gym.make("homing_gym/LocalHoming-v0", scene=scene, start_distance=(0.3, 1.0),
+                   **MEASURED_WITH)
     env.reset(seed=0)
     return env
 
@@ -287,7 +289,7 @@ def measure_layout() -> dict:
     import homing_gym
 
     gym.register_envs(homing_gym)
-    env = gym.make("homing_gym/LandmarkNavigation-v0")
+    env = gym.make("homing_gym/LandmarkNavigation-v0", **MEASURED_WITH)
     env.reset(seed=0)
     try:
         seen = scan_visibility(env)

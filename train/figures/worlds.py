@@ -43,9 +43,13 @@ def world_row(scene: str, seed: int, size: int = 240) -> np.ndarray:
     right = np.concatenate([labelled(views["raycast"], f"seed {seed}: raycast", 2 * size),
                             labelled(views["tiny"], "tiny", 2 * size)])
     height = max(size, right.shape[0])
-    pad = lambda img: np.concatenate([img, np.full((height - img.shape[0], img.shape[1], 3),  # noqa: E731
-                                                   BG, np.uint8)])
-    return np.concatenate([pad(top), pad(right)], axis=1)
+    return np.concatenate([_pad(top, height), _pad(right, height)], axis=1)
+
+
+def _pad(image: np.ndarray, height: int) -> np.ndarray:
+    """``image`` with background rows below it up to ``height``."""
+    fill = np.full((height - image.shape[0], image.shape[1], 3), BG, np.uint8)
+    return np.concatenate([image, fill])
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -56,6 +56,7 @@ from homing_gym.geometry import wrap_angle  # noqa: E402
 from homing_gym.scenes.base import clearance  # noqa: E402
 from homing_gym.topdown import HOME, MapCanvas, draw_pose, draw_scene  # noqa: E402
 from homing_train.harness.metrics import wilson_interval  # noqa: E402
+from homing_train.figures import MEASURED_WITH  # noqa: E402
 from homing_train.harness.protocols import ring_starts  # noqa: E402
 
 ENV_ID = "homing_gym/LocalHoming-v0"
@@ -99,7 +100,7 @@ class Renderer:
     """Renders panoramas in the arena with the robot body placed under the camera."""
 
     def __init__(self) -> None:
-        self.env = gym.make(ENV_ID, obs_keys=("panorama", "goal"))
+        self.env = gym.make(ENV_ID, obs_keys=("panorama", "goal"), **MEASURED_WITH)
         self.env.reset(seed=0, options={"home": HOME_POSE, "start": (1.0, 1.0, 0.0)})
         self.scene = self.env.unwrapped.scene
 
@@ -310,7 +311,8 @@ def run_success(out: str, trials: int, workers: int, seed: int, bins=FIG6_BINS,
     from homing_train.harness.evaluate import run_episodes
     from homing_train.harness.policies import policy_spec
 
-    kwargs = {"obs_keys": ["panorama", "goal", "goal_step"], "max_episode_steps": max_steps}
+    kwargs = {"obs_keys": ["panorama", "goal", "goal_step"], "max_episode_steps": max_steps,
+              **MEASURED_WITH}
     tasks = fig6_tasks(trials, seed, bins)
     results = {}
     for name in CONTROLLERS:
@@ -372,7 +374,7 @@ def main(argv: list[str] | None = None) -> int:
         from homing_train.harness.evaluate import evaluate, format_summary
 
         kwargs = ({"obs_keys": ["panorama", "goal", "goal_step"]} if args.policy == "distance"
-                  else {})
+                  else {}) | MEASURED_WITH
         result = evaluate(args.policy, ENV_ID, args.episodes, args.seed, kwargs,
                           workers=args.workers)
         result.save(args.out)

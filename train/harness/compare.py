@@ -57,6 +57,9 @@ def markdown_table(results: Sequence[EvalResult]) -> str:
 
 def check_paired(results: Sequence[EvalResult]) -> list[int]:
     """Seeds present in every result (the paired episodes); warns if the suites differ."""
+    renderers = {r.policy: r.env_kwargs.get("renderer", "?") for r in results}
+    if len(set(renderers.values())) > 1:
+        warnings.warn(f"rows differ in renderer: {renderers}", stacklevel=2)
     envs = {(r.env_id, repr(sorted(r.env_kwargs.items()))) for r in results}
     if len(envs) > 1:
         warnings.warn(f"results come from different envs or env kwargs: {sorted(envs)}",

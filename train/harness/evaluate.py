@@ -26,6 +26,7 @@ import numpy as np
 from tqdm import tqdm
 
 import homing_gym
+from homing_gym.env import simulation_settings
 from homing_gym.paths import NoPathError, path_length, shortest_path
 from homing_gym.geometry import wrap_angle
 from homing_train.extras import require_extra
@@ -383,6 +384,7 @@ def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int =
     if spec.kind == "controller" and "obs_keys" not in env_kwargs:
         # what the controller reads; observation keys never change the episodes
         env_kwargs["obs_keys"] = list(spec.build().observation_keys())
+    env_kwargs = {**simulation_settings(env_kwargs), **env_kwargs}   # recorded explicitly
     settings = json.loads(json.dumps({"policy": spec.label, "params": spec.resolved_params(),
                                       "env_id": env_id, "env_kwargs": env_kwargs,
                                       **({"tasks": tasks} if tasks is not None else {})},

@@ -77,11 +77,17 @@ def cell_methods(protocol: Protocol) -> list[str]:
     return names
 
 
+#: Settings a shipped policy keeps from its own record in every protocol.
+POLICY_OWN = ("renderer", "physics_substeps", "supersampling")
+
+
 def equal_time_kwargs(setting_kwargs: dict, recorded: dict) -> dict:
     """A shipped policy's recorded env kwargs under a setting's: the setting wins, except
-    that a step cap counted at :data:`BASE_PERIOD` becomes the same time at the policy's
-    control period."""
-    merged = {**recorded, **setting_kwargs}
+    that the policy keeps its own renderer and physics (:data:`POLICY_OWN`: what it was
+    trained with, until it is retrained) and a step cap counted at :data:`BASE_PERIOD`
+    becomes the same time at the policy's control period."""
+    merged = {**recorded, **setting_kwargs,
+              **{key: recorded[key] for key in POLICY_OWN if key in recorded}}
     period = float(recorded.get("control_period", BASE_PERIOD))
     if "max_episode_steps" in setting_kwargs and period != BASE_PERIOD:
         merged["max_episode_steps"] = max(1, round(setting_kwargs["max_episode_steps"]

@@ -29,6 +29,10 @@ import numpy as np
 from homing_gym.scenes import scene_factory
 from homing_gym.scenes.base import clearance
 
+#: The renderer and physics every version-1 protocol was measured with (homing-gym 0.1's
+#: env defaults: TinyRenderer, 1/240 s physics steps), pinned so that its cells reproduce
+#: under later defaults.
+V1_SIMULATION = {"renderer": "tiny", "physics_substeps": 24}
 #: (seed, start pose or None, home pose or None): one episode; None lets the env draw it.
 Task = tuple
 #: The name standing for every shipped PPO policy trained on the protocol's env.
@@ -109,16 +113,18 @@ def common_heading_starts(scene: str, distance: float, n: int, seed: int,
 @dataclass(frozen=True)
 class Setting:
     """One part of a protocol: ``env_id`` with ``env_kwargs`` (``success_on="stop"`` is
-    added), its episodes from ``tasks(episodes, seed)`` or, without it, seeds only (the
-    env draws start and home)."""
+    added) under ``simulation`` (renderer and physics, pinned: :data:`V1_SIMULATION`
+    by default), its episodes from ``tasks(episodes, seed)`` or, without it, seeds only
+    (the env draws start and home)."""
 
     label: str
     env_id: str
     env_kwargs: dict = field(default_factory=dict)
     tasks: Callable[[int, int], list[Task]] | None = None
+    simulation: dict = field(default_factory=lambda: dict(V1_SIMULATION))
 
     def kwargs(self) -> dict:
-        return {**self.env_kwargs, "success_on": "stop"}
+        return {**self.simulation, **self.env_kwargs, "success_on": "stop"}
 
     def episode_tasks(self, episodes: int, seed: int) -> list[Task]:
         if self.tasks is None:

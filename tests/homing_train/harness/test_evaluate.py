@@ -97,7 +97,8 @@ def test_eval_cli_writes_json_and_csv(tmp_path, capsys):
     doc = json.loads(out.read_text())
     assert doc["schema"] == 1 and doc["policy"] == "random" and doc["seed"] == 4
     assert doc["params"]["step_length"] == 0.15
-    assert doc["env_kwargs"] == {**SHORT, "obs_keys": ["panorama", "goal"]}   # recorded as used
+    assert doc["env_kwargs"] == {**SHORT, "obs_keys": ["panorama", "goal"],     # recorded as used
+                                 "renderer": "raycast", "physics_substeps": 12}
     for key in ("episodes", "success_rate", "success_ci", "spl", "soft_spl",
                 "final_distance_mean", "path_length_mean", "steps_mean", "success_by_distance"):
         assert key in doc["summary"]

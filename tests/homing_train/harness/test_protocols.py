@@ -61,6 +61,22 @@ def test_a_policy_with_a_longer_control_period_gets_the_same_time():
     assert equal_time_kwargs({"scene": "lab"}, recorded)["max_episode_steps"] == 250
 
 
+def test_a_policy_keeps_its_own_renderer_and_physics():
+    recorded = {"renderer": "tiny", "physics_substeps": 24, "panorama_shape": [32, 128]}
+    merged = equal_time_kwargs({"scene": "random_rooms", "renderer": "raycast",
+                                "physics_substeps": 12, "success_on": "stop"}, recorded)
+    assert merged["renderer"] == "tiny" and merged["physics_substeps"] == 24
+    assert merged["scene"] == "random_rooms"
+
+
+def test_version_1_protocols_pin_tinyrenderer_and_240_hz_physics():
+    for p in PROTOCOLS.values():
+        for setting in p.settings:
+            if p.version == 1:
+                assert setting.kwargs()["renderer"] == "tiny"
+                assert setting.kwargs()["physics_substeps"] == 24
+
+
 def test_policies_expand_to_the_shipped_policies_of_the_protocols_env():
     methods = cell_methods(protocol("local-common"))
     assert "policies" not in methods and "oracle" in methods
