@@ -33,6 +33,9 @@ from homing_gym.scenes.base import clearance
 #: env defaults: TinyRenderer, 1/240 s physics steps), pinned so that its cells reproduce
 #: under later defaults.
 V1_SIMULATION = {"renderer": "tiny", "physics_substeps": 24}
+#: The renderer and physics of version-2 protocols: homing-gym 0.2's defaults (the ray
+#: caster, 1/120 s physics steps).
+V2_SIMULATION = {"renderer": "raycast", "physics_substeps": 12}
 #: (seed, start pose or None, home pose or None): one episode; None lets the env draw it.
 Task = tuple
 #: The name standing for every shipped PPO policy trained on the protocol's env.
@@ -179,9 +182,17 @@ FOOT = 0.3048
 NEST = (0.0, 0.0, 0.0)
 LOCAL = "homing_gym/LocalHoming-v0"
 HOMING_METHODS = ("oracle", "random", "snapshot", "warping", "distance", POLICIES)
-#: Held out from every shipped policy's training: seeds of the procedural arena far from
+#: Held out from every shipped policy's training: seeds of the procedural worlds far from
 #: the training seeds, and scenes it never saw.
 UNSEEN_SEED = 10_000_000
+#: The worlds of ``local-common`` v2: the paper scenes and the procedural worlds.
+COMMON_SCENES = ("arena", "hallway", "lab", "house", "random_rooms", "random_nature")
+PROCEDURAL = ("random_arena", "random_rooms", "random_nature")
+
+
+def _held_out(episodes: int, seed: int) -> list[Task]:
+    """Seeds from :data:`UNSEEN_SEED` on: procedural worlds no policy trained on."""
+    return [(UNSEEN_SEED + seed + i, None, None) for i in range(episodes)]
 
 PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
     Protocol(
@@ -229,17 +240,20 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
         ("multires", "oracle", "random"), episodes=6,
         paper="§4: arrival within 10 cm and 2 deg of each work location"),
     Protocol(
-        "local-common", 1, "one LocalHoming suite for every homing method and policy: "
-        "arena, hallway, lab and house, homes anywhere",
-        tuple(Setting(scene, LOCAL, {"scene": scene})
-              for scene in ("arena", "hallway", "lab", "house")),
+        "local-common", 2, "one LocalHoming suite for every homing method and policy: "
+        "arena, hallway, lab, house and the procedural random_rooms and random_nature, "
+        "homes anywhere; ray cast, 1/120 s physics (v1: the first four scenes, TinyRenderer)",
+        tuple(Setting(scene, LOCAL, {"scene": scene}, simulation=V2_SIMULATION)
+              for scene in COMMON_SCENES),
         HOMING_METHODS, episodes=5),
     Protocol(
-        "unseen", 1, "worlds no shipped policy was trained on: held-out procedural arenas "
-        f"(seeds from {UNSEEN_SEED}), hallway, lab and house",
-        (Setting("random_arena (held out)", LOCAL, {"scene": "random_arena"},
-                 lambda n, seed: [(UNSEEN_SEED + seed + i, None, None) for i in range(n)]),
-         *(Setting(scene, LOCAL, {"scene": scene}) for scene in ("hallway", "lab", "house"))),
+        "unseen", 2, "worlds no shipped policy was trained on: held-out procedural worlds "
+        f"(random_arena, random_rooms, random_nature; seeds from {UNSEEN_SEED}), hallway, lab "
+        "and house; ray cast, 1/120 s physics (v1: random_arena only, TinyRenderer)",
+        (*(Setting(f"{scene} (held out)", LOCAL, {"scene": scene}, _held_out, V2_SIMULATION)
+           for scene in PROCEDURAL),
+         *(Setting(scene, LOCAL, {"scene": scene}, simulation=V2_SIMULATION)
+           for scene in ("hallway", "lab", "house"))),
         HOMING_METHODS, episodes=5),
 )}
 

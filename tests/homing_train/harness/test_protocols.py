@@ -69,12 +69,23 @@ def test_a_policy_keeps_its_own_renderer_and_physics():
     assert merged["scene"] == "random_rooms"
 
 
-def test_version_1_protocols_pin_tinyrenderer_and_240_hz_physics():
+def test_protocols_pin_their_renderer_and_physics():
+    """Version 1 was measured with TinyRenderer and 1/240 s, version 2 ray casts at
+    1/120 s; both are explicit, so a change of the env defaults changes no cell."""
+    expected = {1: ("tiny", 24), 2: ("raycast", 12)}
     for p in PROTOCOLS.values():
         for setting in p.settings:
-            if p.version == 1:
-                assert setting.kwargs()["renderer"] == "tiny"
-                assert setting.kwargs()["physics_substeps"] == 24
+            kwargs = setting.kwargs()
+            assert (kwargs["renderer"], kwargs["physics_substeps"]) == expected[p.version]
+
+
+def test_unseen_worlds_are_held_out_seeds_of_every_procedural_world():
+    unseen = protocol("unseen")
+    scenes = [s.env_kwargs["scene"] for s in unseen.settings]
+    assert {"random_arena", "random_rooms", "random_nature"} <= set(scenes)
+    for setting in unseen.settings:
+        if setting.env_kwargs["scene"].startswith("random"):
+            assert all(seed >= 10_000_000 for seed, _, _ in setting.episode_tasks(5, 0))
 
 
 def test_policies_expand_to_the_shipped_policies_of_the_protocols_env():
