@@ -194,3 +194,18 @@ def test_benchmark_mesh_world_has_ten_thousand_triangles(make_env):
     for _ in range(20):
         _, _, terminated, truncated, info = env.step(env.action_space.sample())
     assert truncated and not terminated
+
+
+def test_homing_eval_takes_a_mesh_scene_in_worker_processes(room_files, tmp_path):
+    import json
+
+    from homing_train.harness import eval_command
+
+    out = tmp_path / "oracle.json"
+    kwargs = {"scene": f"mesh:{room_files / 'room.glb'}", "success_on": "stop",
+              "max_episode_steps": 300}
+    assert eval_command.main(["--policy", "oracle", "--episodes", "2", "--workers", "2",
+                              "--env-kwargs", json.dumps(kwargs), "--out", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    assert doc["env_kwargs"]["scene"] == kwargs["scene"]
+    assert doc["summary"]["episodes"] == 2 and doc["summary"]["success_rate"] == 1.0
