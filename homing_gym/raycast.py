@@ -148,14 +148,15 @@ class RayCaster:
         origin = np.array([x, y, camera_height])
         cast_columns(self._tris, self._normals, self._closed, origin, yaw, beta, tan_elev,
                      hit, weights)
-        colors = np.empty((H, W, 3))
+        colors = np.empty((H, W, 3), np.float32)    # what the box average takes
         shade(hit, weights, self._lit_colors(lighting or DEFAULT_LIGHTING, origin), self._texture,
               self._uvs, self._atlas, self._levels, self._first_level, self._texel_density,
               self._tris, self._normals, origin, spacing, self.sky, colors)
         if k > 1:   # the mean of each pixel's k x k samples (INTER_AREA: box average)
-            colors = cv2.resize(colors.astype(np.float32), (W // k, H // k),
-                                interpolation=cv2.INTER_AREA)
-        return photometric((colors * 255 + 0.5).astype(np.uint8), lighting)
+            colors = cv2.resize(colors, (W // k, H // k), interpolation=cv2.INTER_AREA)
+        colors *= 255
+        colors += 0.5
+        return photometric(colors.astype(np.uint8), lighting)
 
     def panorama(self, pose, camera_height: float, config: CameraConfig,
                  lighting: Lighting | None = None, supersampling: int | None = None) -> np.ndarray:
