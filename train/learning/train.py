@@ -471,6 +471,27 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
     return model
 
 
+def _benchmark(parser, config: TrainConfig, steps: int) -> int:
+    """``--benchmark``: print the throughput table of ``config``."""
+    from homing_gym.env import simulation_settings
+    from homing_train.learning.throughput import measure, table
+
+    if steps < config.ppo.get("n_steps", 2048) * config.n_envs:
+        parser.error(f"--benchmark {steps}: at least one rollout is needed, n_steps x n_envs "
+                     f"= {config.ppo.get('n_steps', 2048) * config.n_envs} steps")
+    sim = simulation_settings(config.env_kwargs)
+    shape = config.env_kwargs.get("panorama_shape", "48x256")
+    shape = "x".join(map(str, shape)) if isinstance(shape, (list, tuple)) else shape
+    label = (f"{config.env_id.split('/')[-1]} {config.env_kwargs.get('scene', '')} {shape} "
+             f"{sim['renderer']}, {config.extractor}, n_epochs {config.ppo.get('n_epochs')}, "
+             f"batch {config.ppo.get('batch_size')}, {config.vec}")
+    try:
+        print(table([measure(config, steps, label)]))
+    except (ValueError, EnvWorkerError) as err:
+        parser.exit(2, f"homing-train: error: {err}\n")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = command_parser("homing-train", __doc__)
     parser.add_argument("--env", default="homing_gym/LocalHoming-v0")
@@ -489,6 +510,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--device")
     parser.add_argument("--extractor", choices=EXTRACTORS)
     parser.add_argument("--no-progress", action="store_true")
+    parser.add_argument("--benchmark", type=int, metavar="STEPS", nargs="?", const=4096,
+                        help="measure this configuration's throughput over STEPS env steps "
+                             "(env alone, inference, PPO end to end and its rollout/update "
+                             "split; default 4096) and print it; trains nothing, writes "
+                             "nothing")
     args = parser.parse_args(argv)
     try:
         require_extra("train", "homing-train")
@@ -513,6 +539,8 @@ def main(argv: list[str] | None = None) -> int:
                                    f"_s{config.seed}")
     except ValueError as err:
         parser.error(str(err))
+    if args.benchmark is not None:
+        return _benchmark(parser, config, args.benchmark)
     try:
         train(config, run, resume=bool(args.resume), progress=not args.no_progress)
     except (ValueError, EnvWorkerError) as err:

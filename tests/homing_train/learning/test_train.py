@@ -311,3 +311,20 @@ def test_an_env_error_in_a_subprocess_worker_is_said_once_not_as_eoferror(tmp_pa
     assert done.stderr.count("boom: the user env failed at step 5") == 1, done.stderr[-3000:]
     assert "ValueError" in done.stderr and "EOFError" not in done.stderr
     assert "Traceback" not in done.stderr
+
+
+def test_benchmark_measures_the_ppo_time_split_and_writes_nothing(tmp_path, capsys,
+                                                                  monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    args = ["--benchmark", "128", "--n-envs", "1", "--vec", "dummy", "--hp", "n_steps=64",
+            "--hp", "batch_size=32", "--hp", "n_epochs=1",
+            "--env-kwargs", '{"scene": "arena", "panorama_shape": [16, 64]}']
+    assert main(args) == 0
+    rows = [line for line in capsys.readouterr().out.splitlines() if line.startswith("| Local")]
+    assert len(rows) == 1
+    cells = [c.strip() for c in rows[0].strip("|").split("|")]
+    env_rate, inference, ppo, rollout, update = map(float, cells[2:7])
+    assert min(env_rate, inference, ppo, rollout, update) > 0
+    assert list(tmp_path.iterdir()) == []
+    with pytest.raises(SystemExit):
+        main(["--benchmark", "10", "--hp", "n_steps=64"])     # less than one rollout

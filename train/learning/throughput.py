@@ -1,0 +1,114 @@
+"""``homing-train --benchmark``: where PPO's time goes, for one training configuration.
+
+Three measurements in one process, with the configuration's envs (``n_envs`` of them,
+``vec`` workers), network and PPO settings:
+
+* ``env``: env steps per second of the vectorised envs alone, random actions;
+* ``inference``: samples per second of the policy's forward pass (sampling actions), on
+  batches of ``n_envs`` observations, as during rollouts;
+* ``ppo``: env steps per second of ``PPO.learn`` end to end, split into the time spent
+  collecting rollouts (envs and inference) and the time spent updating (``n_epochs``
+  passes of minibatches of ``batch_size``), timed with SB3's rollout callbacks.
+
+Nothing is written; the table goes to stdout. Rates are medians of nothing: one run of
+``steps`` each, so compare configurations measured in the same session.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from homing_train.learning.train import TrainConfig, make_vec
+
+
+@dataclass
+class Throughput:
+    """Rates (per second) and the PPO time split of one configuration."""
+
+    label: str
+    n_envs: int
+    env_steps_per_s: float
+    inference_per_s: float
+    ppo_steps_per_s: float
+    rollout_s: float
+    update_s: float
+
+    @property
+    def update_share(self) -> float:
+        """Share of ``PPO.learn``'s time spent in updates."""
+        return self.update_s / max(self.rollout_s + self.update_s, 1e-9)
+
+
+def _rollout_timer():
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    class RolloutTimer(BaseCallback):
+        """Adds up the wall time between SB3's rollout start and end."""
+
+        def __init__(self):
+            super().__init__()
+            self.rollout_s, self._t0 = 0.0, 0.0
+
+        def _on_rollout_start(self) -> None:
+            self._t0 = time.perf_counter()
+
+        def _on_rollout_end(self) -> None:
+            self.rollout_s += time.perf_counter() - self._t0
+
+        def _on_step(self) -> bool:
+            return True
+
+    return RolloutTimer()
+
+
+def measure(config: TrainConfig, steps: int, label: str = "") -> Throughput:
+    """Measure ``config`` over ``steps`` env steps (each of the three parts)."""
+    import torch
+    from stable_baselines3 import PPO
+
+    from homing_train.learning.extractor import policy_kwargs_for
+
+    torch.set_num_threads(config.torch_threads)
+    env = make_vec(config, config.n_envs, config.seed)
+    try:
+        env.action_space.seed(config.seed)
+        env.reset()
+        rounds = max(steps // config.n_envs, 1)
+        t0 = time.perf_counter()
+        for _ in range(rounds):
+            env.step(np.array([env.action_space.sample() for _ in range(config.n_envs)]))
+        env_rate = rounds * config.n_envs / (time.perf_counter() - t0)
+        model = PPO("MultiInputPolicy", env, seed=config.seed, device=config.device, verbose=0,
+                    policy_kwargs=policy_kwargs_for(
+                        config.extractor, **({"features_dim": config.features_dim}
+                                             if config.extractor == "panorama" else {})),
+                    **config.ppo)
+        obs = env.reset()
+        model.policy.set_training_mode(False)
+        t0 = time.perf_counter()
+        for _ in range(rounds):
+            model.predict(obs, deterministic=False)
+        inference = rounds * config.n_envs / (time.perf_counter() - t0)
+        timer = _rollout_timer()
+        t0 = time.perf_counter()
+        model.learn(steps, callback=timer, progress_bar=False)
+        total = time.perf_counter() - t0
+    finally:
+        env.close()
+    return Throughput(label or config.env_id, config.n_envs, env_rate, inference,
+                      model.num_timesteps / total, timer.rollout_s, total - timer.rollout_s)
+
+
+def table(rows: list[Throughput]) -> str:
+    """A Markdown table of the measurements."""
+    lines = ["| configuration | envs | env steps/s (random actions) | inference samples/s | "
+             "PPO env steps/s | rollout s | update s | update share |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        lines.append(f"| {r.label} | {r.n_envs} | {r.env_steps_per_s:.0f} | "
+                     f"{r.inference_per_s:.0f} | {r.ppo_steps_per_s:.0f} | {r.rollout_s:.1f} | "
+                     f"{r.update_s:.1f} | {100 * r.update_share:.0f}% |")
+    return "\n".join(lines)
