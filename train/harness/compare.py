@@ -55,15 +55,42 @@ def markdown_table(results: Sequence[EvalResult]) -> str:
     return "\n".join(rows) + "\n"
 
 
+#: Env settings that never change an episode (what a controller reads), left out when
+#: rows are compared.
+NEUTRAL_KEYS = ("obs_keys",)
+
+
+def settings_notes(results: Sequence[EvalResult]) -> list[str]:
+    """Lines saying where the rows' envs differ: the renderer, and the settings of rows
+    that depart from the most common ones (a shipped policy's own, by design)."""
+    notes = []
+    renderers: dict[str, list[str]] = {}
+    for r in results:
+        renderers.setdefault(str(r.env_kwargs.get("renderer", "?")), []).append(r.policy)
+    if len(renderers) > 1:
+        notes.append("rows differ in renderer: " + "; ".join(
+            f"{name} ({', '.join(rows)})" for name, rows in renderers.items()))
+    def key(r: EvalResult) -> str:
+        return repr((r.env_id, sorted((k, v) for k, v in r.env_kwargs.items()
+                                      if k not in NEUTRAL_KEYS)))
+    counts: dict[str, int] = {}
+    for r in results:
+        counts[key(r)] = counts.get(key(r), 0) + 1
+    common = max(counts, key=counts.get)
+    reference = next(r for r in results if key(r) == common)
+    for r in results:
+        if key(r) != common:
+            changed = sorted(k for k in set(r.env_kwargs) | set(reference.env_kwargs)
+                             if k not in NEUTRAL_KEYS
+                             and r.env_kwargs.get(k) != reference.env_kwargs.get(k))
+            where = f"{r.env_id}, " if r.env_id != reference.env_id else ""
+            notes.append(f"{r.policy} runs with other env settings: {where}"
+                         + ", ".join(f"{k}={r.env_kwargs.get(k)!r}" for k in changed))
+    return notes
+
+
 def check_paired(results: Sequence[EvalResult]) -> list[int]:
-    """Seeds present in every result (the paired episodes); warns if the suites differ."""
-    renderers = {r.policy: r.env_kwargs.get("renderer", "?") for r in results}
-    if len(set(renderers.values())) > 1:
-        warnings.warn(f"rows differ in renderer: {renderers}", stacklevel=2)
-    envs = {(r.env_id, repr(sorted(r.env_kwargs.items()))) for r in results}
-    if len(envs) > 1:
-        warnings.warn(f"results come from different envs or env kwargs: {sorted(envs)}",
-                      stacklevel=2)
+    """Seeds present in every result (the paired episodes); warns if they differ."""
     seeds = [set(e.seed for e in r.episodes) for r in results]
     shared = sorted(set.intersection(*seeds))
     if any(s != seeds[0] for s in seeds):
@@ -178,6 +205,9 @@ def compare(paths: Sequence[str], out: str, trajectories: int = 3) -> dict[str, 
                "final_distance": os.path.join(out, "final_distance.png")}
     with open(written["table"], "w") as f:
         f.write(markdown_table(results))
+        notes = settings_notes(results)
+        if notes:
+            f.write("\n" + "".join(f"Note: {n}.\n" for n in notes))
     plot_success_vs_distance(results, written["success_vs_distance"])
     plot_final_distance(results, written["final_distance"])
     if trajectories > 0 and shared:

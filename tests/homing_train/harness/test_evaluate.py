@@ -276,3 +276,21 @@ def test_route_shortest_path_visits_every_target(make_env, controller_for):
     assert record.success
     assert abs(record.shortest_path - legs) < 0.01
     assert record.spl > 0.85
+
+
+def test_compare_notes_say_which_rows_differ_in_renderer_and_settings():
+    from homing_train.harness.compare import settings_notes
+
+    def result(policy, **kwargs):
+        return EvalResult(policy, {}, "homing_gym/LocalHoming-v0", kwargs, 0, [],
+                          summary={"episodes": 0})
+
+    same = {"renderer": "raycast", "physics_substeps": 12}
+    rows = [result("oracle", **same, obs_keys=["panorama"]),
+            result("distance", **same, obs_keys=["panorama", "goal_step"]),
+            result("ppo", renderer="tiny", physics_substeps=24, panorama_shape=[32, 128])]
+    notes = settings_notes(rows)
+    assert notes[0] == "rows differ in renderer: raycast (oracle, distance); tiny (ppo)"
+    assert notes[1] == ("ppo runs with other env settings: panorama_shape=[32, 128], "
+                        "physics_substeps=24, renderer='tiny'")
+    assert settings_notes(rows[:2]) == []          # obs_keys change no episode
