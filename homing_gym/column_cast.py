@@ -20,6 +20,8 @@ import math
 import numpy as np
 from numba import njit
 
+from homing_gym.shadows import in_shadow
+
 #: Hits nearer than this (metres, horizontally) are ignored: the camera's own position.
 NEAR = 1e-6
 
@@ -203,7 +205,9 @@ def _texel(atlas: np.ndarray, levels: np.ndarray, m: int, s: float, v: float,
 def shade(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.ndarray,
           uvs: np.ndarray, atlas: np.ndarray, levels: np.ndarray, first_level: np.ndarray,
           texel_density: np.ndarray, tris: np.ndarray, normals: np.ndarray,
-          origin: np.ndarray, ray_spacing: float, sky: np.ndarray, out: np.ndarray) -> None:
+          origin: np.ndarray, ray_spacing: float, sky: np.ndarray, out: np.ndarray,
+          shaded: np.ndarray, shadow_depth: np.ndarray, shadow_axes: np.ndarray,
+          shadow_origin: np.ndarray, shadow_cell: float) -> None:
     """Colour per pixel (``out (H, W, 3)`` in ``[0, 1]``): ``sky`` where nothing was hit,
     else the triangle's lit colour ``base`` times its texture (``u`` left to right, ``v``
     bottom to top, wrapped), clipped.
@@ -217,8 +221,13 @@ def shade(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.nd
     texture flattened one after another; ``levels[m] = (offset, height, width)`` of mip
     level ``m``, texture ``k``'s levels from ``first_level[k]`` to ``first_level[k + 1]``
     (full resolution first, each half the size of the one before). A face whose UVs cover
-    no area (one texel for the whole face) takes that texel."""
+    no area (one texel for the whole face) takes that texel.
+
+    Cast shadows (:mod:`homing_gym.shadows`; off when ``shadow_depth`` is empty): a point
+    in the shadow of the map takes ``shaded[t]`` (the ambient light alone) instead of
+    ``base[t]``."""
     H, W = hit.shape
+    shadows = shadow_depth.size > 0
     near, far = np.empty(3), np.empty(3)
     for i in range(H):
         for j in range(W):
@@ -228,15 +237,23 @@ def shade(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.nd
                 continue
             r, g, b = base[t, 0], base[t, 1], base[t, 2]
             k = texture[t]
-            if k >= 0:
-                s = v = 0.0
-                px = py = pz = 0.0
+            px = py = pz = 0.0
+            if k >= 0 or shadows:
                 for c in range(3):
-                    s += weights[i, j, c] * uvs[t, c, 0]
-                    v += weights[i, j, c] * uvs[t, c, 1]
                     px += weights[i, j, c] * tris[t, c, 0]
                     py += weights[i, j, c] * tris[t, c, 1]
                     pz += weights[i, j, c] * tris[t, c, 2]
+            if shadows and (r, g, b) != (shaded[t, 0], shaded[t, 1], shaded[t, 2]):
+                facing = (normals[t, 0] * shadow_axes[2, 0] + normals[t, 1] * shadow_axes[2, 1]
+                          + normals[t, 2] * shadow_axes[2, 2])
+                if in_shadow(shadow_depth, shadow_axes, shadow_origin, shadow_cell,
+                             px, py, pz, facing):
+                    r, g, b = shaded[t, 0], shaded[t, 1], shaded[t, 2]
+            if k >= 0:
+                s = v = 0.0
+                for c in range(3):
+                    s += weights[i, j, c] * uvs[t, c, 0]
+                    v += weights[i, j, c] * uvs[t, c, 1]
                 dx, dy, dz = px - origin[0], py - origin[1], pz - origin[2]
                 length = math.sqrt(dx * dx + dy * dy + dz * dz)
                 facing = abs(normals[t, 0] * dx + normals[t, 1] * dy + normals[t, 2] * dz)

@@ -88,7 +88,7 @@ class HomingEnv(gym.Env):
                  odometry_noise: float = 0.02, odometry_origin: str = "start",
                  lighting_change: float = 0.0, goal_step_length: float = 0.15,
                  camera_height: float = RobotConfig.camera_height, drive: str = "differential",
-                 sky_color: tuple[float, float, float] | None = None):
+                 sky_color: tuple[float, float, float] | None = None, shadows: bool = False):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"unknown render_mode {render_mode!r}; allowed: "
                              f"{self.metadata['render_modes']} or None")
@@ -153,6 +153,10 @@ class HomingEnv(gym.Env):
                     isinstance(c, (int, float)) and 0 <= c <= 1 for c in sky_color):
                 raise ValueError(f"sky_color must be three RGB values in [0, 1], "
                                  f"got {sky_color!r}")
+        if shadows not in (True, False):
+            raise ValueError(f"shadows must be True or False, got {shadows!r}")
+        if shadows and renderer != "raycast":
+            raise ValueError(f"shadows needs renderer='raycast', got renderer={renderer!r}")
         if drive == "synchro" and action_type != "continuous":
             raise ValueError("drive='synchro' takes continuous actions (vx, vy); got "
                              f"action_type={action_type!r}")
@@ -175,7 +179,7 @@ class HomingEnv(gym.Env):
         self.sim = Simulator(self.scene, gui=render_mode == "human",
                              time_step=self.control_period / self.physics_substeps,
                              robot_config=self.robot_config, renderer=renderer,
-                             sky_color=sky_color)
+                             sky_color=sky_color, shadows=bool(shadows))
         self.camera = PanoramaCamera(
             camera_config, self.robot_config.camera_height, renderer=self.sim.renderer,
             caster=(lambda: self.sim.caster) if self.sim.caster is not None else None)

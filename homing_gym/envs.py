@@ -124,6 +124,8 @@ class LocalHomingEnv(HomingEnv):
     ``camera_height`` = 0.30 (metres above the floor, 0.005-5; below the robot's top,
     about 0.1 m, use ``renderer="raycast"``, which never sees the robot's own body),
     ``sky_color`` (RGB in [0, 1] of rays that hit nothing; ``renderer="raycast"`` only),
+    ``shadows`` = False (``renderer="raycast"`` only: objects cast shadows from the scene
+    light, which moves with ``lighting_change``; see :mod:`homing_gym.shadows`),
     ``start_distance`` (its minimum at least ``success_radius``), ``success_radius``,
     ``success_on``, ``reward`` (a
     ``RewardConfig``, or a dict of some of its fields, e.g. ``{"progress": 10.0}``),

@@ -41,8 +41,11 @@ import numpy as np
 from homing_gym.column_cast import cast_columns, shade
 from homing_gym.panorama import (DEFAULT_LIGHTING, CameraConfig, Lighting, column_bearing,
                                  photometric, row_elevation)
+from homing_gym.shadows import ShadowMap, shadow_map
 from homing_gym.worldmesh import WorldMesh
 
+#: The shadow map of a caster without shadows (empty: ``shade`` skips the lookups).
+_NO_SHADOWS = ShadowMap(np.zeros((0, 0)), np.eye(3), np.zeros(2), 1.0)
 #: Colour of rays that hit nothing (RGB in [0, 1]); TinyRenderer's background is white.
 SKY_COLOR = (1.0, 1.0, 1.0)
 
@@ -106,7 +109,7 @@ def texel_density(mesh: WorldMesh) -> np.ndarray:
 class RayCaster:
     """Casts and shades rays in one world mesh; rebuilt when the world changes."""
 
-    def __init__(self, mesh: WorldMesh, sky_color=SKY_COLOR):
+    def __init__(self, mesh: WorldMesh, sky_color=SKY_COLOR, shadows: bool = False):
         if len(mesh.triangles) == 0:
             raise ValueError("the world mesh has no triangles")
         if not np.all(np.isfinite(mesh.triangles)):
@@ -128,6 +131,15 @@ class RayCaster:
         self._first_level = np.concatenate(
             [[0], np.cumsum([len(p) for p in pyramids])]).astype(np.int64)
         self._texel_density = texel_density(mesh)
+        #: Cast shadows (:mod:`homing_gym.shadows`); maps cached per light direction.
+        self.shadows = shadows
+        self._shadow_maps: dict[tuple, ShadowMap] = {}
+
+    def _shadow_map(self, lighting: Lighting) -> ShadowMap:
+        key = tuple(lighting.direction)
+        if key not in self._shadow_maps:
+            self._shadow_maps[key] = shadow_map(self._tris, lighting.direction)
+        return self._shadow_maps[key]
 
     def _lit_colors(self, lighting: Lighting, origin: np.ndarray) -> np.ndarray:
         """Each triangle's colour times ``ambient + diffuse * max(0, n . l)`` seen from
@@ -149,9 +161,13 @@ class RayCaster:
         cast_columns(self._tris, self._normals, self._closed, origin, yaw, beta, tan_elev,
                      hit, weights)
         colors = np.empty((H, W, 3), np.float32)    # what the box average takes
-        shade(hit, weights, self._lit_colors(lighting or DEFAULT_LIGHTING, origin), self._texture,
+        light = lighting or DEFAULT_LIGHTING
+        shadow = self._shadow_map(light) if self.shadows else _NO_SHADOWS
+        shade(hit, weights, self._lit_colors(light, origin), self._texture,
               self._uvs, self._atlas, self._levels, self._first_level, self._texel_density,
-              self._tris, self._normals, origin, spacing, self.sky, colors)
+              self._tris, self._normals, origin, spacing, self.sky, colors,
+              self.mesh.colors * light.ambient, shadow.depth, shadow.axes, shadow.origin,
+              shadow.cell)
         if k > 1:   # the mean of each pixel's k x k samples (INTER_AREA: box average)
             colors = cv2.resize(colors, (W // k, H // k), interpolation=cv2.INTER_AREA)
         colors *= 255

@@ -48,7 +48,7 @@ class Simulator:
 
     def __init__(self, scene: Scene, *, gui: bool = False, time_step: float = 1 / 120,
                  robot_config: RobotConfig = RobotConfig(), renderer: str = "raycast",
-                 sky_color: tuple[float, float, float] | None = None):
+                 sky_color: tuple[float, float, float] | None = None, shadows: bool = False):
         with native_output_captured():    # the C++ core prints "argv[0]=" on connecting
             self.client = BulletClient(connection_mode=p.GUI if gui else p.DIRECT)
         self._connected = True
@@ -57,8 +57,9 @@ class Simulator:
         self.renderer = load_egl(c) if renderer == "egl" else p.ER_TINY_RENDERER
         self._sky_color = sky_color
         #: The ray caster of the current world (``renderer="raycast"``), else None.
-        self.caster = (RayCaster(world_mesh(scene), self.sky(scene)) if renderer == "raycast"
-                       else None)
+        self._shadows = shadows
+        self.caster = (RayCaster(world_mesh(scene), self.sky(scene), shadows)
+                       if renderer == "raycast" else None)
         self.time_step = time_step
         self._gui = gui
         self._robot_config = robot_config
@@ -261,7 +262,7 @@ class Simulator:
             self.scene = scene
             self._make_objects(scene)
         if self.caster is not None:
-            self.caster = RayCaster(world_mesh(scene), self.sky(scene))
+            self.caster = RayCaster(world_mesh(scene), self.sky(scene), self._shadows)
 
     def sky(self, scene: Scene) -> tuple[float, float, float]:
         """The ray caster's sky: the env's ``sky_color``, else the scene's, else white."""

@@ -176,3 +176,35 @@ def test_camera_height_and_sky_color():
         gym.make("homing_gym/LocalHoming-v0", renderer="tiny", sky_color=(0, 0, 1))
     with pytest.raises(ValueError, match="camera_height"):
         gym.make("homing_gym/LocalHoming-v0", camera_height=-1)
+
+
+def test_cast_shadows_darken_the_floor_behind_an_object_and_nothing_else(make_env):
+    """A 1 m box at the origin, the light from +x at 45 degrees: the floor from x = -0.2
+    to about -1.2 m (|y| < 0.5) lies in its shadow and gets the ambient light alone."""
+    from homing_gym.panorama import CameraConfig, Lighting
+    from homing_gym.raycast import RayCaster
+    from homing_gym.worldmesh import world_mesh
+
+    scene = Scene("block", ((-3, -3), (3, 3)),
+                  landmarks=(Landmark((0.0, 0.0), shape="box", extent=(0.4, 1.0),
+                                      height=1.0, color=(0.8, 0.8, 0.8, 1.0)),),
+                  floor_color=(0.8, 0.8, 0.8, 1.0))
+    config = CameraConfig(panorama_shape=(60, 360))
+    light = Lighting(direction=(1.0, 0.0, 1.0))
+    camera = (-2.0, 0.0, 0.0)
+
+    def pixel(image, x, y):
+        d = math.hypot(x - camera[0], y - camera[1])
+        column = int(bearing_column(math.atan2(y - camera[1], x - camera[0]), 360))
+        row = int((config.vfov / 2 + math.atan(0.3 / d)) / config.vfov * 60)
+        return 255 * float(luminance(image[row:row + 1, column:column + 1])[0, 0])
+
+    plain = RayCaster(world_mesh(scene)).panorama(camera, 0.3, config, light)
+    shaded = RayCaster(world_mesh(scene), shadows=True).panorama(camera, 0.3, config, light)
+    lit = 0.8 * (light.ambient + light.diffuse / math.sqrt(2)) * 255
+    assert pixel(plain, -0.7, 0.0) == pytest.approx(lit, abs=3)
+    assert pixel(shaded, -0.7, 0.0) == pytest.approx(0.8 * light.ambient * 255, abs=3)
+    for x, y in ((-0.7, 1.5), (-1.4, 0.0), (-0.5, -1.2)):          # beside or beyond it
+        assert pixel(shaded, x, y) == pytest.approx(pixel(plain, x, y), abs=1)
+    with pytest.raises(ValueError, match="shadows needs renderer='raycast'"):
+        make_env(renderer="tiny", shadows=True)
