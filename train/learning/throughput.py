@@ -21,8 +21,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from homing_train.learning.train import TrainConfig, make_vec
-
 
 @dataclass
 class Throughput:
@@ -64,42 +62,28 @@ def _rollout_timer():
     return RolloutTimer()
 
 
-def measure(config: TrainConfig, steps: int, label: str = "") -> Throughput:
-    """Measure ``config`` over ``steps`` env steps (each of the three parts)."""
-    import torch
-    from stable_baselines3 import PPO
-
-    from homing_train.learning.extractor import policy_kwargs_for
-
-    torch.set_num_threads(config.torch_threads)
-    env = make_vec(config, config.n_envs, config.seed)
-    try:
-        env.action_space.seed(config.seed)
-        env.reset()
-        rounds = max(steps // config.n_envs, 1)
-        t0 = time.perf_counter()
-        for _ in range(rounds):
-            env.step(np.array([env.action_space.sample() for _ in range(config.n_envs)]))
-        env_rate = rounds * config.n_envs / (time.perf_counter() - t0)
-        model = PPO("MultiInputPolicy", env, seed=config.seed, device=config.device, verbose=0,
-                    policy_kwargs=policy_kwargs_for(
-                        config.extractor, **({"features_dim": config.features_dim}
-                                             if config.extractor == "panorama" else {})),
-                    **config.ppo)
-        obs = env.reset()
-        model.policy.set_training_mode(False)
-        t0 = time.perf_counter()
-        for _ in range(rounds):
-            model.predict(obs, deterministic=False)
-        inference = rounds * config.n_envs / (time.perf_counter() - t0)
-        timer = _rollout_timer()
-        t0 = time.perf_counter()
-        model.learn(steps, callback=timer, progress_bar=False)
-        total = time.perf_counter() - t0
-    finally:
-        env.close()
-    return Throughput(label or config.env_id, config.n_envs, env_rate, inference,
-                      model.num_timesteps / total, timer.rollout_s, total - timer.rollout_s)
+def measure(env, model, steps: int, label: str) -> Throughput:
+    """Measure a vectorised ``env`` and a PPO ``model`` built on it (as ``homing-train``
+    builds them) over ``steps`` env steps, each of the three parts; closes nothing."""
+    n_envs = env.num_envs
+    rounds = max(steps // n_envs, 1)
+    env.reset()
+    t0 = time.perf_counter()
+    for _ in range(rounds):
+        env.step(np.array([env.action_space.sample() for _ in range(n_envs)]))
+    env_rate = rounds * n_envs / (time.perf_counter() - t0)
+    obs = env.reset()
+    model.policy.set_training_mode(False)
+    t0 = time.perf_counter()
+    for _ in range(rounds):
+        model.predict(obs, deterministic=False)
+    inference = rounds * n_envs / (time.perf_counter() - t0)
+    timer = _rollout_timer()
+    t0 = time.perf_counter()
+    model.learn(steps, callback=timer, progress_bar=False)
+    total = time.perf_counter() - t0
+    return Throughput(label, n_envs, env_rate, inference, model.num_timesteps / total,
+                      timer.rollout_s, total - timer.rollout_s)
 
 
 def table(rows: list[Throughput]) -> str:

@@ -355,13 +355,25 @@ def warm_starts(config: TrainConfig, progress: bool = True) -> list[tuple[str, A
     return steps
 
 
+def new_model(config: TrainConfig, env, **kwargs):
+    """A fresh PPO model of ``config`` on the vectorised ``env`` (``kwargs``: more PPO
+    arguments, e.g. ``tensorboard_log``)."""
+    from stable_baselines3 import PPO
+
+    from homing_train.learning.extractor import policy_kwargs_for
+
+    extractor_kwargs = ({"features_dim": config.features_dim}
+                        if config.extractor == "panorama" else {})
+    return PPO("MultiInputPolicy", env, seed=config.seed, device=config.device, verbose=0,
+               policy_kwargs=policy_kwargs_for(config.extractor, **extractor_kwargs),
+               **config.ppo, **kwargs)
+
+
 def train(config: TrainConfig, out: Path, resume: bool = False,
           command: str | None = None, progress: bool = True):
     """Train (or, with ``resume``, continue) a run in folder ``out``; returns the model."""
     from stable_baselines3 import PPO
     from stable_baselines3.common.callbacks import CheckpointCallback, EvalCallback
-
-    from homing_train.learning.extractor import policy_kwargs_for
 
     import torch
 
@@ -396,13 +408,7 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
                              tensorboard_log=str(out / "tb"))
             model._last_obs = None      # learn() resets the envs, with their new seeds
         else:
-            model = PPO("MultiInputPolicy", env, seed=config.seed, device=config.device,
-                        tensorboard_log=str(out / "tb"), verbose=0,
-                        policy_kwargs=policy_kwargs_for(config.extractor,
-                                                        **({"features_dim": config.features_dim}
-                                                           if config.extractor == "panorama"
-                                                           else {})),
-                        **config.ppo)
+            model = new_model(config, env, tensorboard_log=str(out / "tb"))
             if config.init_policy:
                 load_policy_weights(model, config.init_policy)
             for name, warm_start in warm_starts(config, progress):
@@ -479,14 +485,22 @@ def _benchmark(parser, config: TrainConfig, steps: int) -> int:
     if steps < config.ppo.get("n_steps", 2048) * config.n_envs:
         parser.error(f"--benchmark {steps}: at least one rollout is needed, n_steps x n_envs "
                      f"= {config.ppo.get('n_steps', 2048) * config.n_envs} steps")
+    import torch
+
     sim = simulation_settings(config.env_kwargs)
     shape = config.env_kwargs.get("panorama_shape", "48x256")
     shape = "x".join(map(str, shape)) if isinstance(shape, (list, tuple)) else shape
     label = (f"{config.env_id.split('/')[-1]} {config.env_kwargs.get('scene', '')} {shape} "
              f"{sim['renderer']}, {config.extractor}, n_epochs {config.ppo.get('n_epochs')}, "
              f"batch {config.ppo.get('batch_size')}, {config.vec}")
+    torch.set_num_threads(config.torch_threads)
     try:
-        print(table([measure(config, steps, label)]))
+        env = make_vec(config, config.n_envs, config.seed)
+        try:
+            env.action_space.seed(config.seed)
+            print(table([measure(env, new_model(config, env), steps, label)]))
+        finally:
+            env.close()
     except (ValueError, EnvWorkerError) as err:
         parser.exit(2, f"homing-train: error: {err}\n")
     return 0

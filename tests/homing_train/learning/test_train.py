@@ -324,7 +324,7 @@ def test_benchmark_measures_the_ppo_time_split_and_writes_nothing(tmp_path, caps
     assert len(rows) == 1
     cells = [c.strip() for c in rows[0].strip("|").split("|")]
     env_rate, inference, ppo, rollout, update = map(float, cells[2:7])
-    assert min(env_rate, inference, ppo, rollout, update) > 0
+    assert min(env_rate, inference, ppo) > 0 and min(rollout, update) >= 0
     assert list(tmp_path.iterdir()) == []
     with pytest.raises(SystemExit):
         main(["--benchmark", "10", "--hp", "n_steps=64"])     # less than one rollout
