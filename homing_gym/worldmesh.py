@@ -76,6 +76,7 @@ class _Builder:
         self.uvs: list[np.ndarray] = []
         self.textures: list[np.ndarray] = []
         self.closed: list[bool] = []
+        self.inside: list[np.ndarray] = []      # a point inside the solid, or NaN
         self._texture_ids: dict[str, int] = {}
 
     def texture_id(self, name: str | None) -> int:
@@ -92,14 +93,12 @@ class _Builder:
 
     def triangle(self, corners, uv, color, tex: int, inside=None) -> None:
         """One triangle; ``inside``: a point inside the closed solid it bounds (the
-        triangle is then wound counter-clockwise seen from outside), or None."""
-        c, t = np.asarray(corners, np.float64), np.asarray(uv, np.float64)
-        if inside is not None:
-            normal = np.cross(c[1] - c[0], c[2] - c[0])
-            if normal @ (c.mean(axis=0) - np.asarray(inside, np.float64)) < 0:
-                c, t = c[[0, 2, 1]], t[[0, 2, 1]]
-        self.tris.append(c)
-        self.uvs.append(t)
+        triangle is then wound counter-clockwise seen from outside, in :meth:`mesh`), or
+        None."""
+        self.tris.append(np.asarray(corners, np.float64))
+        self.uvs.append(np.asarray(uv, np.float64))
+        self.inside.append(np.full(3, np.nan) if inside is None
+                           else np.asarray(inside, np.float64))
         self.colors.append(np.asarray(color[:3], np.float64))
         self.tex.append(tex)
         self.closed.append(inside is not None)
@@ -157,6 +156,7 @@ class _Builder:
         tris = part.triangles
         self.tris.extend(tris)
         self.closed.extend(part.closed)
+        self.inside.extend(np.full((len(tris), 3), np.nan))
         if part.texture is None:
             self.colors.extend(part.face_colors)
             self.tex.extend([-1] * len(tris))
@@ -167,8 +167,16 @@ class _Builder:
             self.uvs.extend(part.uvs[part.faces])
 
     def mesh(self) -> WorldMesh:
-        return WorldMesh(np.array(self.tris, np.float32), np.array(self.colors, np.float32),
-                         np.array(self.tex, np.int32), np.array(self.uvs, np.float32),
+        """The collected triangles; those of built solids turned counter-clockwise seen
+        from outside (their normal pointing away from the point inside)."""
+        tris, uvs = np.array(self.tris, np.float64), np.array(self.uvs, np.float64)
+        inside = np.array(self.inside, np.float64).reshape(-1, 3)
+        normal = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
+        outward = np.einsum("ij,ij->i", normal, tris.mean(axis=1) - inside)
+        flip = outward < 0                              # False where inside is NaN
+        tris[flip], uvs[flip] = tris[flip][:, [0, 2, 1]], uvs[flip][:, [0, 2, 1]]
+        return WorldMesh(tris.astype(np.float32), np.array(self.colors, np.float32),
+                         np.array(self.tex, np.int32), uvs.astype(np.float32),
                          self.textures, np.array(self.closed, bool))
 
 
