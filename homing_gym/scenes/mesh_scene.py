@@ -37,15 +37,6 @@ UP_AXES = ("z", "y")
 DEFAULT_FACE_COLOR = (0.7, 0.7, 0.7)
 #: Margin (metres) around the blocking footprint when ``bounds`` are not given.
 BOUNDS_MARGIN = 0.05
-#: ``"mesh:PATH?key=value"`` options and how to read their values.
-SPEC_OPTIONS = {
-    "scale": float,
-    "up": str,
-    "offset": lambda v: tuple(float(x) for x in v.split(",")),
-    "fence": lambda v: _flag(v),
-    "ground_plane": lambda v: _flag(v),
-    "bounds": lambda v: _bounds_from_list([float(x) for x in v.split(",")]),
-}
 
 
 def _flag(value: str) -> bool:
@@ -58,6 +49,17 @@ def _bounds_from_list(values: list[float]):
     if len(values) != 4:
         raise ValueError(f"expected xmin,ymin,xmax,ymax, got {values!r}")
     return (values[0], values[1]), (values[2], values[3])
+
+
+#: ``"mesh:PATH?key=value"`` options and how to read their values.
+SPEC_OPTIONS = {
+    "scale": float,
+    "up": str,
+    "offset": lambda v: tuple(float(x) for x in v.split(",")),
+    "fence": _flag,
+    "ground_plane": _flag,
+    "bounds": lambda v: _bounds_from_list([float(x) for x in v.split(",")]),
+}
 
 
 def _placement(scale: float, up: str, offset) -> np.ndarray:

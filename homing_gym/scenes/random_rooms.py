@@ -158,7 +158,7 @@ def random_rooms_scene(rng: np.random.Generator) -> Scene:
     for room in rooms:
         for _ in range(int(rng.integers(1, 5))):
             item = _furniture(room, rng) if rng.random() < 0.75 else _plant(room, rng)
-            if min(math.dist(item.position, d) for d in doors) < 0.8 if doors else False:
+            if doors and min(math.dist(item.position, d) for d in doors) < 0.8:
                 continue                          # keep doorways clear
             trial = scene_with([*scene.landmarks, item])
             if _connected(trial):
