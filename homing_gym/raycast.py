@@ -166,8 +166,8 @@ class RayCaster:
         shade(hit, weights, self._lit_colors(light, origin), self._texture,
               self._uvs, self._atlas, self._levels, self._first_level, self._texel_density,
               self._tris, self._normals, origin, spacing, self.sky, colors,
-              self.mesh.colors * light.ambient, shadow.depth, shadow.axes, shadow.origin,
-              shadow.cell)
+              self.mesh.colors * light.ambient if self.shadows else self.mesh.colors,
+              shadow.depth, shadow.axes, shadow.origin, shadow.cell)
         if k > 1:   # the mean of each pixel's k x k samples (INTER_AREA: box average)
             colors = cv2.resize(colors, (W // k, H // k), interpolation=cv2.INTER_AREA)
         colors *= 255
