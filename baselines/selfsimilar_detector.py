@@ -43,7 +43,6 @@ panorama alike (columns wrap around in a panorama).
 from __future__ import annotations
 
 import math
-import statistics
 from dataclasses import dataclass, field
 from functools import lru_cache
 
@@ -52,7 +51,7 @@ from numba import njit
 
 from homing_baselines.camera_models import CameraModel
 from homing_gym.geometry import wrap_angle
-from homing_gym.vision import luminance
+from homing_gym.vision import LUMA, luminance
 from homing_gym.selfsimilar import (BARCODE_BANDS, DEFAULT_P, PanelLayout, check_p,
                                     decode_barcode)
 
@@ -149,8 +148,28 @@ class Detection:
 
 
 def to_gray(image: np.ndarray) -> np.ndarray:
-    """Luminance in ``[0, 1]`` (float32) of a uint8 RGB or grey image."""
-    return luminance(image)
+    """Luminance in ``[0, 1]`` (float32) of a uint8 RGB(A) or grey image: BT.601 luma,
+    as :func:`homing_gym.vision.luminance` but compiled, ``(0.299 r + 0.587 g + 0.114 b)
+    / 255`` in float32 left to right (numpy's matrix product may round the last bit
+    differently: values differ by at most 2e-8)."""
+    img = np.asarray(image)
+    if img.ndim != 3 or img.dtype != np.uint8:
+        return luminance(img)
+    if img.shape[-1] not in (3, 4):
+        raise ValueError(f"expected an RGB image (..., 3), got shape {img.shape}")
+    return _luma(np.ascontiguousarray(img), *LUMA)
+
+
+@njit(cache=True)
+def _luma(img, r, g, b):
+    out = np.empty(img.shape[:2], np.float32)
+    flat, channels = img.reshape(-1), img.shape[2]
+    dest = out.reshape(-1)
+    for i in range(dest.size):
+        j = channels * i
+        dest[i] = (np.float32(flat[j]) * r + np.float32(flat[j + 1]) * g
+                   + np.float32(flat[j + 2]) * b) / np.float32(255.0)
+    return out
 
 
 @lru_cache(maxsize=32)
@@ -395,22 +414,6 @@ def _chains(rows: list[list[_Match]], cfg: DetectorConfig) -> list[list[_Match]]
     return [c for c in chains if len(c) >= cfg.min_group]
 
 
-def _interp(gray: np.ndarray, y: int, xs: np.ndarray) -> np.ndarray:
-    """Row ``y`` of ``gray`` at fractional columns ``xs`` (linear, ``np.interp``; the end
-    values beyond the image)."""
-    return np.interp(xs, np.arange(gray.shape[1]), gray[y]).astype(np.float32)
-
-
-def _columns(gray: np.ndarray, xs: np.ndarray, y0: int, y1: int) -> np.ndarray:
-    """Rows ``y0 .. y1-1`` of ``gray`` at fractional columns ``xs`` inside the image,
-    ``(y1 - y0, len(xs))`` float32: :func:`_interp` of every row at once (the same
-    float64 arithmetic as ``np.interp``: ``(right - left) * t + left``)."""
-    i = np.floor(xs).astype(np.int64)
-    left = gray[y0:y1, i].astype(np.float64)
-    right = gray[y0:y1, i + 1].astype(np.float64)
-    return ((right - left) * (xs - i) + left).astype(np.float32)
-
-
 @njit(cache=True)
 def _walk(gray, y, direction, limit, a, b, level, w, xi, ta, wa0, wa1, tb, wb0, wb1):
     """The last row reached from row ``y`` moving by ``direction`` (at most ``limit``
@@ -431,85 +434,213 @@ def _walk(gray, y, direction, limit, a, b, level, w, xi, ta, wa0, wa1, tb, wb0, 
     return y
 
 
-def _extent(gray: np.ndarray, chain: list[_Match], a: float, b: float, strength: float,
-            cfg: DetectorConfig) -> tuple[float, float]:
-    """Rows of the pattern's top and bottom edges along the line ``x = a y + b``: walked
-    from the outermost matches while ``m_y`` stays above half the chain's median peak
-    ``strength``; each edge lies halfway between the last row that passes and the next."""
-    taps = _taps(cfg.p, cfg.window)
-    edges = []
-    for start, direction in ((chain[0].y, -1), (chain[-1].y, 1)):
-        y = _walk(gray, start, direction, 2 * cfg.row_step, float(a), float(b),
-                  0.5 * strength, cfg.window, *taps)
-        edges.append(y + 0.5 * direction)
-    return edges[0], edges[1]
+# The per-chain steps below (§3.2: line, extent, pattern width, barcode) are compiled
+# too, one call per frame for all chains. They keep the arithmetic of the numpy
+# formulation they replace: np.interp's float64 ``(right - left) t + left`` rounded to
+# float32; np.percentile's "linear" method (float32 difference, float64 weight);
+# comparisons and edge offsets in float32 with the threshold rounded to float32 (numpy 2
+# casts a Python float to the array's type); the barcode column's mean of three samples
+# as ``(c0 + c1) + c2`` and each band's sum as numpy's add.reduce does it (first element
+# plus the pairwise sum of the rest), so every decision is the same.
+@njit(cache=True)
+def _line(ys, xs):
+    """Least-squares line ``x = a y + b`` through the matches (§3.2): ``(a, b)``."""
+    my, mx = ys.mean(), xs.mean()
+    dy = ys - my
+    a = (dy * (xs - mx)).sum() / (dy * dy).sum()
+    return a, mx - a * my
 
 
-def _pattern_width(profile: np.ndarray, lo: float, hi: float, cfg: DetectorConfig,
-                   tolerance: float = 0.07) -> float:
+@njit(cache=True)
+def _profile(row, x0):
+    """Row ``row`` at columns ``x0, x0 + 1, ...`` up to the image's last column (float32;
+    linear interpolation, the end values beyond the row)."""
+    n = max(0, int(math.ceil(row.size - x0 - 1)))
+    out = np.empty(n, np.float32)
+    for t in range(n):
+        x = x0 + t
+        if x < 0:
+            out[t] = row[0]
+        elif x >= row.size - 1:
+            out[t] = row[row.size - 1]
+        else:
+            i = int(math.floor(x))
+            left, right = np.float64(row[i]), np.float64(row[i + 1])
+            out[t] = np.float32((right - left) * (x - i) + left)
+    return out
+
+
+@njit(cache=True)
+def _percentile(values, q):
+    """The ``q``-th percentile (0-100) of float32 ``values`` (numpy's "linear" method)."""
+    s = np.sort(values)
+    n = s.size
+    v = (n - 1) * (q / 100.0)
+    if v >= n - 1:
+        return np.float64(s[n - 1])
+    i = int(math.floor(v))
+    gamma = v - i
+    diff = s[i + 1] - s[i]                       # float32
+    if gamma >= 0.5:
+        return np.float64(s[i + 1]) - np.float64(diff) * (1.0 - gamma)
+    return np.float64(s[i]) + np.float64(diff) * gamma
+
+
+@njit(cache=True)
+def _pattern_width(profile, thr, root, window, gap, tolerance):
     """The apparent pattern width sigma (pixels) from the intensity ``profile`` to the
     right of the origin (sample ``t`` at ``t`` pixels), or ``nan``.
 
     The stripe edges of ``s_p`` lie at ``sigma p^(n/2)``: consecutive edges have the
-    ratio ``sqrt(p)``, which survives affine and (nearly) perspective distortion. sigma
-    is the largest dark-to-bright edge whose three preceding edges keep that ratio (within
-    ``tolerance``) and after which the profile stays bright for at least half the gap
-    (the next edge of the barcode breaks the ratio: the gap is much narrower than a
-    stripe).
+    ratio ``root`` = ``sqrt(p)``, which survives affine and (nearly) perspective
+    distortion. sigma is the largest dark-to-bright edge (crossing of ``thr``) whose three
+    preceding edges keep that ratio (within ``tolerance``) and after which the profile
+    stays bright for at least ``gap`` (a fraction of sigma; the next edge, the barcode's,
+    breaks the ratio: the gap is much narrower than a stripe).
     """
-    thr = (lo + hi) / 2
-    bright = profile > thr
-    flips = np.flatnonzero(bright[:-1] != bright[1:]) + 1
-    if flips.size < 4:
+    t32 = np.float32(thr)
+    edges = np.empty(profile.size, np.float64)
+    rising = np.empty(profile.size, np.bool_)
+    m = 0
+    for f in range(1, profile.size):
+        before, after = profile[f - 1], profile[f]
+        if (before > t32) != (after > t32):
+            step = after - before if after != before else np.float32(1e-6)
+            edges[m] = np.float64(f - 1) + np.float64((t32 - before) / step)
+            rising[m] = after > t32
+            m += 1
+    if m < 4:
         return math.nan
-    # sub-pixel edge positions by linear interpolation between samples f - 1 and f
-    before, after = profile[flips - 1], profile[flips]
-    edges = flips - 1 + (thr - before) / np.where(after != before, after - before, 1e-6)
-    rising = bright[flips]
-    root = math.sqrt(cfg.p)
-    gap = 0.5 * cfg.layout.gap / cfg.layout.pattern_width
-    for j in range(edges.size - 1, 2, -1):
-        sigma = float(edges[j])
-        if sigma < cfg.window / 2:
+    for j in range(m - 1, 2, -1):
+        sigma = edges[j]
+        if sigma < window / 2:
             break
         if not rising[j]:
             continue
-        ratios = edges[j - 3:j] / edges[j - 2:j + 1]
-        if np.any(np.abs(ratios - root) > tolerance):
+        keeps = True
+        for i in range(j - 3, j):
+            if abs(edges[i] / edges[i + 1] - root) > tolerance:
+                keeps = False
+        if not keeps:
             continue
-        if j + 1 < edges.size and edges[j + 1] < sigma * (1 + gap):
+        if j + 1 < m and edges[j + 1] < sigma * (1 + gap):
             continue
         return sigma
     return math.nan
 
 
-def _barcode(gray: np.ndarray, x_bar: float, half: float, top: float, bottom: float,
-             thr: float) -> int | None:
-    """Read the barcode column centred on column ``x_bar`` (``half`` pixels either side)
-    between the guard bands found within half a pattern height of ``top``/``bottom``."""
+@njit(cache=True)
+def _sum(values):
+    """numpy's pairwise sum of float32 ``values`` (8 accumulators, blocks of 128)."""
+    n = values.size
+    if n < 8:
+        res = np.float32(0.0)
+        for i in range(n):
+            res += values[i]
+        return res
+    if n <= 128:
+        r = values[:8].copy()
+        i = 8
+        while i < n - n % 8:
+            for k in range(8):
+                r[k] += values[i + k]
+            i += 8
+        res = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]))
+        for k in range(i, n):
+            res += values[k]
+        return res
+    half = n // 2
+    half -= half % 8
+    return _sum(values[:half]) + _sum(values[half:])
+
+
+@njit(cache=True)
+def _barcode_bands(gray, x_bar, half, top, bottom, thr):
+    """The ``BARCODE_BANDS`` band values (1 = dark) of the barcode column centred on
+    column ``x_bar`` (``half`` pixels either side), between the guard bands found within
+    half a pattern height of ``top``/``bottom``; empty when there is no such column."""
+    none = np.empty(0, np.int64)
     h = bottom - top
-    y0, y1 = max(0, int(math.floor(top - 0.5 * h))), min(gray.shape[0], int(math.ceil(bottom + 0.5 * h)))
+    y0 = max(0, int(math.floor(top - 0.5 * h)))
+    y1 = min(gray.shape[0], int(math.ceil(bottom + 0.5 * h)))
     if y1 - y0 < BARCODE_BANDS or not (0 <= x_bar - half and x_bar + half < gray.shape[1] - 1):
-        return None
-    xs = x_bar + np.array([-half, 0.0, half])
-    column = _columns(gray, xs, y0, y1).mean(axis=1)
-    dark = np.flatnonzero(column < thr)
+        return none
+    column = np.empty(y1 - y0, np.float32)
+    xs = (x_bar - half, x_bar, x_bar + half)
+    for y in range(y0, y1):
+        acc = np.float32(0.0)
+        for k in range(3):
+            i = int(math.floor(xs[k]))
+            left, right = np.float64(gray[y, i]), np.float64(gray[y, i + 1])
+            acc += np.float32((right - left) * (xs[k] - i) + left)
+        column[y - y0] = acc / np.float32(3.0)
+    t32 = np.float32(thr)
+    dark = np.flatnonzero(column < t32)
     if dark.size == 0:
-        return None
-    start, end = y0 + int(dark[0]) - 0.5, y0 + int(dark[-1]) + 0.5
+        return none
+    start, end = y0 + dark[0] - 0.5, y0 + dark[-1] + 0.5
     band = (end - start) / BARCODE_BANDS
     if band < 1.0 or not (0.5 < (end - start) / h < 2.0):
-        return None
-    # each band's mean over its central half: rows [lo, hi) (sums by np.add.reduceat over
-    # the bounds lo_0, hi_0, lo_1, ...; every other sum is a band's)
-    bounds = []
-    for i in range(BARCODE_BANDS):
-        lo = int(round(start + (i + 0.25) * band + 0.5))
-        bounds += [lo - y0, max(lo + 1, int(round(start + (i + 0.75) * band + 0.5))) - y0]
-    bounds = np.array(bounds)
-    sums = np.add.reduceat(np.append(column, np.float32(0)), bounds)[::2]
-    means = sums / (bounds[1::2] - bounds[::2]).astype(np.float32)
-    return decode_barcode([int(m < thr) for m in means])
+        return none
+    bands = np.empty(BARCODE_BANDS, np.int64)
+    for i in range(BARCODE_BANDS):    # each band's mean over its central half
+        lo = min(int(np.rint(start + (i + 0.25) * band + 0.5)) - y0, column.size - 1)
+        hi = min(max(lo + 1, int(np.rint(start + (i + 0.75) * band + 0.5)) - y0), column.size)
+        total = column[lo] + _sum(column[lo + 1:hi])
+        bands[i] = total / np.float32(hi - lo) < t32
+    return bands
+
+
+@njit(cache=True)
+def _describe_chains(gray, starts, ys, xs, values, row_step, root, gap, half_ratio,
+                     bar_ratio, w, xi, ta, wa0, wa1, tb, wb0, wb1):
+    """Line, extent, pattern width and barcode of every chain (§3.2); chain ``c`` is
+    the matches ``starts[c]:starts[c + 1]`` of ``ys``, ``xs`` (float64) and ``values``.
+    Returns ``(n, 8)`` float64 rows ``a, x0, y_mid, top, bottom, sigma, strength,
+    has_bands`` and ``(n, BARCODE_BANDS)`` band values.
+
+    The extent: walked along the line from the outermost matches while ``m_y`` stays
+    above half the chain's median peak (its ``strength``); each edge lies halfway between
+    the last row that passes and the next. The pattern width from the middle row's
+    profile right of the line, thresholded halfway between the 5th and 95th percentiles
+    of its first ``w`` pixels; the barcode ``bar_ratio * sigma`` right of the line,
+    ``half_ratio * sigma`` either side."""
+    n = starts.size - 1
+    out = np.full((n, 8), np.nan)
+    bands = np.zeros((n, BARCODE_BANDS), np.int64)
+    for c in range(n):
+        cy, cx = ys[starts[c]:starts[c + 1]], xs[starts[c]:starts[c + 1]]
+        a, b = _line(cy, cx)
+        strength = np.median(values[starts[c]:starts[c + 1]])
+        top = _walk(gray, int(cy[0]), -1, 2 * row_step, a, b, 0.5 * strength,
+                    w, xi, ta, wa0, wa1, tb, wb0, wb1) - 0.5
+        bottom = _walk(gray, int(cy[-1]), 1, 2 * row_step, a, b, 0.5 * strength,
+                       w, xi, ta, wa0, wa1, tb, wb0, wb1) + 0.5
+        y_mid = int(np.rint((top + bottom) / 2 - 0.5))
+        x0 = a * y_mid + b
+        profile = _profile(gray[y_mid], x0)
+        head = profile[:w]
+        lo, hi = _percentile(head, 5.0), _percentile(head, 95.0)
+        thr = (lo + hi) / 2
+        sigma = _pattern_width(profile, thr, root, w, gap, 0.07)
+        out[c] = np.array([a, x0, np.float64(y_mid), top, bottom, sigma, strength, 0.0])
+        if math.isfinite(sigma):
+            found = _barcode_bands(gray, x0 + bar_ratio * sigma, half_ratio * sigma, top,
+                                   bottom, thr)
+            if found.size:
+                bands[c] = found
+                out[c, 7] = 1.0
+    return out, bands
+
+
+def _chain_arrays(chains: list[list[_Match]]) -> tuple[np.ndarray, ...]:
+    """The chains as flat arrays for :func:`_describe_chains`: start offsets, rows,
+    columns, peak values."""
+    matches = [m for chain in chains for m in chain]
+    starts = np.cumsum([0] + [len(chain) for chain in chains])
+    return (starts, np.array([m.y for m in matches], np.float64),
+            np.array([m.x for m in matches], np.float64),
+            np.array([m.value for m in matches], np.float64))
 
 
 def detect_landmarks(image: np.ndarray, model: CameraModel,
@@ -521,33 +652,25 @@ def detect_landmarks(image: np.ndarray, model: CameraModel,
     width = gray.shape[1]
     if model.wraps:  # a panorama: continue each row past its end so patterns may wrap
         gray = np.concatenate([gray, gray[:, :width // 2]], axis=1)
-    cfg = config
+    cfg, lay = config, config.layout
+    chains = _chains(_scan(gray, cfg, width), cfg)
+    if not chains:
+        return []
+    rows, bands = _describe_chains(
+        gray, *_chain_arrays(chains), cfg.row_step, math.sqrt(cfg.p),
+        0.5 * lay.gap / lay.pattern_width, 0.25 * lay.barcode_width / lay.pattern_width,
+        lay.barcode_centre, cfg.window, *_taps(cfg.p, cfg.window))
+    span = (lay.pattern_width + lay.gap + lay.barcode_width) / lay.pattern_width
     found: list[Detection] = []
-    for chain in _chains(_scan(gray, cfg, width), cfg):
-        ys = np.array([m.y for m in chain], dtype=np.float64)
-        xs = np.array([m.x for m in chain], dtype=np.float64)
-        a, b = np.polyfit(ys, xs, 1)
-        strength = statistics.median([m.value for m in chain])
-        top, bottom = _extent(gray, chain, a, b, strength, cfg)
-        y_mid = int(round((top + bottom) / 2 - 0.5))
-        x0 = a * y_mid + b
-        profile = _interp(gray, y_mid, x0 + np.arange(0, gray.shape[1] - x0 - 1))
-        head = profile[:cfg.window]
-        lo, hi = (float(v) for v in np.percentile(head, [5, 95]))
-        sigma = _pattern_width(profile, lo, hi, cfg)
-        lay = cfg.layout
-        landmark_id = None
-        if math.isfinite(sigma):
-            half = 0.25 * lay.barcode_width / lay.pattern_width * sigma
-            landmark_id = _barcode(gray, x0 + lay.barcode_centre * sigma, half, top, bottom,
-                                   (lo + hi) / 2)
+    for chain, (a, x0, y_mid, top, bottom, sigma, strength, has_bands), code in zip(
+            chains, rows.tolist(), bands.tolist()):
+        landmark_id = decode_barcode(code) if has_bands else None
         if cfg.require_id and landmark_id is None:
             continue
-        span = (lay.pattern_width + lay.gap + lay.barcode_width) / lay.pattern_width
         centre = x0 + 0.5 * span * sigma if math.isfinite(sigma) else x0
         found.append(Detection(
-            id=landmark_id, x=float(x0 % width if model.wraps else x0), y=y_mid + 0.0,
-            top=float(top), bottom=float(bottom), slope=float(a), width=sigma,
+            id=landmark_id, x=float(x0 % width if model.wraps else x0), y=y_mid,
+            top=top, bottom=bottom, slope=a, width=sigma,
             centre_x=float(centre % width if model.wraps else centre),
             bearing=wrap_angle(float(model.bearing(centre))),
             distance=model.distance(x0, top, bottom, lay.pattern_height),

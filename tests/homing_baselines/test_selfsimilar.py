@@ -6,9 +6,11 @@ import math
 import numpy as np
 import pytest
 
+import homing_baselines.selfsimilar_detector as det
 from homing_baselines.camera_models import PanoramaModel, PerspectiveModel
 from homing_baselines.selfsimilar_detector import (DetectorConfig, detect_landmarks,
                                                    match_function, match_points)
+from homing_gym.vision import luminance
 from homing_gym.selfsimilar import (BARCODE_BANDS, MAX_ID, PanelLayout, barcode_bits,
                                     decode_barcode, panel_image, self_similar)
 
@@ -70,6 +72,28 @@ def test_compiled_match_function_and_points_agree_with_eq7(w, step):
     assert np.array_equal(match_points(rows, ys, cols * 1, 2 / 3, w), m)
     # outside the image: -1
     assert match_points(rows, [0, 5, 0], [-1, 0, 160 - w + 1], 2 / 3, w).tolist() == [-1] * 3
+
+
+def test_compiled_chain_steps_keep_numpys_arithmetic():
+    """The compiled per-chain steps give numpy's values bit for bit (so the detector's
+    decisions are those of the numpy formulation), and the compiled luminance is BT.601
+    to the last bit or two."""
+    rng = np.random.default_rng(3)
+    for n in (1, 2, 7, 22, 45, 300):
+        v = rng.random(n).astype(np.float32)
+        for q in (5.0, 95.0):
+            assert det._percentile(v, q) == np.percentile(v, [q])[0]
+        band = np.add.reduceat(np.append(v, np.float32(0)), [0, n])[0]   # a band's sum
+        assert v[0] + np.float32(det._sum(v[1:])) == band
+        row = rng.random(n + 2).astype(np.float32)
+        x0 = float(rng.uniform(-1, 3))
+        expected = np.interp(x0 + np.arange(0, row.size - x0 - 1), np.arange(row.size), row)
+        assert np.array_equal(det._profile(row, x0), expected.astype(np.float32))
+    ys = np.arange(5, 50, 3.0)
+    xs = 0.3 * ys + 7 + rng.normal(0, 0.5, ys.size)
+    np.testing.assert_allclose(det._line(ys, xs), np.polyfit(ys, xs, 1), rtol=1e-12)
+    image = rng.integers(0, 256, (30, 40, 3), dtype=np.uint8)
+    np.testing.assert_allclose(det.to_gray(image), luminance(image), rtol=0, atol=2e-7)
 
 
 def test_match_function_is_low_on_other_patterns():
