@@ -1,9 +1,20 @@
 """``selfsimilar``: landmark navigation with self-similar landmarks and a visibility graph
 (Briggs, Scharstein et al. 2000, §4).
 
-The robot knows the landmark design, not the map. Each episode it starts with an empty
-:class:`~homing_baselines.selfsimilar_graph.VisibilityGraph` and a global frame of its own:
-where it was switched on, heading 0 (§4.1). It reads only the observation:
+The robot knows the landmark design, not the map. It builds the map, a
+:class:`~homing_baselines.selfsimilar_graph.VisibilityGraph` with landmark positions, in a
+global frame of its own: where it was first switched on, heading 0 (§4.1). With
+``memory="world"`` (the default: the paper explores once and then navigates, §4, and
+§4.3's probabilities come from "the history of observations") the map persists across the
+episodes of one world (:meth:`SelfSimilarController.check_env`: the env's scene, by name):
+the graph with its look/seen counts and travelled distances, the landmarks scanned from,
+their last known positions, and the pose in which the robot first stood in front of each
+landmark (its *anchor*). A new episode starts somewhere unknown, so the robot is not
+localised: it goes to the nearest visible anchor (the goal if seen), takes the anchor's
+pose as its own when standing there, scans and recalibrates its heading against the
+stored angles (§4.1), and carries what it learnt on the way (graph updates held back,
+landmark positions) into the map frame. With ``memory="episode"`` each episode starts
+with an empty map. It reads only the observation:
 
 * ``view``: the forward perspective camera (the paper's camera; the default panorama is
   far too coarse for the detector, see ``docs/selfsimilar.md``), searched by
@@ -81,6 +92,17 @@ Choices where the paper is silent (also in ``docs/selfsimilar.md``):
   The robot has no obstacle sensor: a straight dead-reckoned leg may run into a wall.
 * *Costs*: edge lengths are metres; ``look_cost`` (m) is both the scan time of §4.1's
   exploration distance and the stay cost ``l_xx`` of §4.3.
+* *Relocalisation across episodes* (``memory="world"``; the paper's robot is switched on
+  once): the robot's pose at a landmark's standing place is about the same every time
+  (within the servoing tolerance, ``ARRIVE_DISTANCE`` and ``ARRIVE_ANGLE``), so the pose
+  of its first arrival there is kept as the landmark's anchor and taken as the pose on a
+  later arrival when not localised; the full scan that follows recalibrates the heading
+  (§4.1). Until then the robot plans nothing over the graph (its angles are in the map
+  frame): it goes from landmark to landmark as from nowhere, preferring anchors, and
+  dead-reckons only to landmarks seen in this episode. A world is named by its scene: the
+  harness builds one controller per worker process, so with ``--workers 1`` the
+  episodes of a run form one sequence in one map; with more workers each keeps its own
+  map of the episodes it happens to get.
 """
 
 from __future__ import annotations
@@ -102,6 +124,7 @@ from homing_gym.geometry import wrap_angle
 from homing_gym.validation import require_positive
 
 PLANNING = ("deterministic", "probabilistic")
+MEMORY = ("world", "episode")
 #: Times the robot servos again at the goal when the episode did not end.
 MAX_REFINES = 3
 #: Scans at one landmark before the robot gives up on it and wanders off.
@@ -140,6 +163,20 @@ class _Scan:
 
 
 @dataclass
+class WorldMap:
+    """What the robot keeps of one world across episodes (``memory="world"``), in the
+    map frame (the robot's own frame of the first episode): the visibility ``graph``,
+    the landmarks ``explored`` (scanned from), the last known ``positions`` (m) of the
+    landmarks seen and the ``standing`` pose (x, y, heading; m, rad) of each landmark
+    stood at, recorded the first time (the anchors of relocalisation)."""
+
+    graph: VisibilityGraph = field(default_factory=VisibilityGraph)
+    explored: set[int] = field(default_factory=set)
+    positions: dict[int, np.ndarray] = field(default_factory=dict)
+    standing: dict[int, np.ndarray] = field(default_factory=dict)
+
+
+@dataclass
 class SelfSimilarController(Controller):
     """Briggs et al.'s explore/navigate controller; see the module docstring.
 
@@ -151,10 +188,13 @@ class SelfSimilarController(Controller):
     standing place from a panel (m). ``step_length``: longest move before looking again
     (m). ``far``: beyond it (m) the approach follows the line of sight. ``look_cost``:
     cost of a scan or of staying (m). ``wander_distance``: move when no landmark is in
-    sight (m).
+    sight (m). ``memory``: ``"world"`` (the paper's: the map persists across the episodes
+    of one world, see the module docstring) or ``"episode"`` (each episode explores from
+    scratch).
     """
 
     planning: str = "deterministic"
+    memory: str = "world"
     view_hfov_deg: float = 60.0
     window: int = 22
     row_step: int = 3
@@ -173,6 +213,9 @@ class SelfSimilarController(Controller):
         if self.planning not in PLANNING:
             raise ValueError(f"selfsimilar: unknown planning {self.planning!r}; "
                              f"allowed: {PLANNING}")
+        if self.memory not in MEMORY:
+            raise ValueError(f"selfsimilar: unknown memory {self.memory!r}; "
+                             f"allowed: {MEMORY}")
         for name in ("view_hfov_deg", "standoff", "step_length", "far", "look_cost",
                      "wander_distance"):
             value = getattr(self, name)
@@ -188,17 +231,34 @@ class SelfSimilarController(Controller):
 
     def __post_init__(self) -> None:
         super().__post_init__()
+        self._maps: dict[str, WorldMap] = {}     # memory="world": one map per world
+        self._world = ""
         self.on_reset()
 
     def observation_keys(self) -> tuple[str, ...]:
         return ("view", "goal_id", "odometry")
 
-    # -- per-episode memory -----------------------------------------------------------------
+    def check_env(self, env) -> None:
+        """Note which world the episodes are in: the env's scene, by name (what an
+        operator tells the robot, "you are in building X"; nothing of its layout, its
+        landmark changes or the robot's pose is read)."""
+        self._world = str(env.unwrapped.scene.name)
+
+    # -- memory -----------------------------------------------------------------------------
     def on_reset(self) -> None:
+        """A new episode: the world's map is kept (``memory="world"``) or started afresh;
+        everything else is per episode. With a map that has anchors, the robot is not
+        localised until it stands at one of them (:meth:`_relocalise`)."""
+        if self.memory == "episode":
+            self._map = WorldMap()
+        else:
+            self._map = self._maps.setdefault(self._world, WorldMap())
         #: The map memory: the visibility graph, the landmarks scanned from, and the
         #: landmark the robot stands at (``None`` between landmarks).
-        self.graph = VisibilityGraph()
-        self.explored: set[int] = set()
+        self.graph = self._map.graph
+        self.explored = self._map.explored
+        self._localised = not self._map.standing  # an empty map: this episode's frame
+        self._unmapped: list[tuple] = []         # graph updates held until localised
         self._pose = np.zeros(3)                 # dead-reckoned (x, y, heading), own frame
         self._odometry: np.ndarray | None = None
         self._rng = np.random.default_rng(self._seed)
@@ -214,8 +274,9 @@ class SelfSimilarController(Controller):
         self._centre: np.ndarray | None = None   # target panel centre, own frame (m)
         self._normal: float | None = None        # its normal, own frame (rad)
         self._refines = 0
-        #: Own-frame position (m) of every landmark seen, for dead reckoning (§4.2).
-        self.positions: dict[int, np.ndarray] = {}
+        #: Position (m) of every landmark seen, for dead reckoning (§4.2): the map's, in
+        #: the map frame, once localised; until then this episode's, in its own frame.
+        self.positions: dict[int, np.ndarray] = self._map.positions if self._localised else {}
         self._reckoning = False                  # servoing towards a remembered position
         self._lost: set[int] = set()             # not found where dead reckoning put them
         self._before_drive: np.ndarray | None = None  # the view when the last drive began
@@ -331,6 +392,10 @@ class SelfSimilarController(Controller):
             self.at = None
         if self.at is None:
             return self._leave_nowhere(scan.seen, goal)
+        if not self._localised:               # at a landmark the map has no anchor for
+            self._unmapped.append(("observe", self.at, {
+                b: (s.distance, s.angle) for b, s in scan.seen.items()}))
+            return self._leave_nowhere(scan.seen, goal)
         self._recalibrate(scan.seen)
         self.graph.observe(self.at, {b: (s.distance, s.angle) for b, s in scan.seen.items()})
         self.explored.add(self.at)
@@ -349,13 +414,16 @@ class SelfSimilarController(Controller):
                 s.angle = wrap_angle(s.angle + shift)
 
     def _leave_nowhere(self, seen: dict[int, Sighting], goal: int) -> Move:
-        """Away from landmarks: to the goal if seen, else the nearest one (§4.2), one
-        not scanned from yet if any is seen; else dead reckoning or wander."""
+        """Away from landmarks, or at one the map has no anchor for while not localised:
+        to the goal if seen, else the nearest one (§4.2): an anchor of the map if any is
+        seen and the robot is not localised, else one not scanned from yet if any is
+        seen; with nothing seen dead reckoning or wander."""
         if not seen:
             return self._reckon_or_wander(goal)
-        new = [b for b in seen if b not in self.explored] or list(seen)
-        target = goal if goal in seen else min(new, key=lambda b: seen[b].distance)
-        self._came_from = None
+        anchors = [] if self._localised else [b for b in seen if b in self._map.standing]
+        options = anchors or [b for b in seen if b not in self.explored] or list(seen)
+        target = goal if goal in seen else min(options, key=lambda b: seen[b].distance)
+        self._came_from = self.at
         return self._head_for(target, seen[target])
 
     # -- planning at a landmark (§4.1-4.3) ---------------------------------------------------
@@ -513,17 +581,67 @@ class SelfSimilarController(Controller):
         self._normal = wrap_angle(normal)
 
     def _arrive(self, goal: int) -> Move | None:
-        """Standing in front of the target: annotate the edge driven (§4.1), then finish
-        (the goal) or scan / plan the next hop."""
+        """Standing in front of the target: annotate the edge driven (§4.1), relocalise
+        at an anchor of the map or record this standing pose as one, then finish (the
+        goal) or scan / plan the next hop."""
         landmark = self._target
         if self._came_from is not None:
-            self.graph.traversed(self._came_from, landmark, self._travelled)
+            self._update_map("traversed", self._came_from, landmark, self._travelled)
         self.at, self._target, self._came_from = landmark, None, None
         self._centre = self._normal = None
         self._scans_here = 0
         self._lost.clear()
+        relocalised = not self._localised and landmark in self._map.standing
+        if relocalised:
+            self._relocalise(landmark)
+        else:
+            self._update_map("stood", landmark, self._pose.copy())
         if landmark == goal:
             return None
-        if self.planning == "probabilistic" or landmark not in self.explored:
+        if (relocalised or not self._localised or self.planning == "probabilistic"
+                or landmark not in self.explored):
             return self._start_scan(goal)
         return self._plan(goal, None)
+
+    def _update_map(self, kind: str, *args) -> None:
+        """A map update: ``("traversed", a, b, metres)`` or ``("stood", landmark, pose)``;
+        held (with ``"observe"`` updates, see :meth:`_scanning`) while the robot is not
+        localised, since its frame is not yet the map's."""
+        if not self._localised:
+            self._unmapped.append((kind, *args))
+        elif kind == "traversed":
+            self.graph.traversed(*args)
+        else:
+            landmark, pose = args
+            self._map.standing.setdefault(landmark, pose)
+
+    def _relocalise(self, landmark: int) -> None:
+        """Standing at ``landmark``, an anchor of the map: take its recorded standing pose
+        as the robot's pose (the scan that follows refines the heading, §4.1), carry this
+        episode's landmark positions and held map updates into the map frame, and use
+        the map's positions from now on."""
+        anchor = self._map.standing[landmark]
+        turn = wrap_angle(anchor[2] - self._pose[2])
+        c, s = math.cos(turn), math.sin(turn)
+        rotation = np.array([[c, -s], [s, c]])
+
+        def to_map(point: np.ndarray) -> np.ndarray:
+            return anchor[:2] + rotation @ (point - self._pose[:2])
+
+        for b, point in self.positions.items():
+            self._map.positions[b] = to_map(point)
+        held, self._unmapped, self._localised = self._unmapped, [], True
+        for kind, *args in held:
+            if kind == "observe":
+                at, seen = args
+                self.graph.observe(at, {b: (d, wrap_angle(a + turn))
+                                        for b, (d, a) in seen.items()})
+                self.explored.add(at)
+            elif kind == "stood":
+                b, pose = args
+                self._update_map("stood", b, np.array([*to_map(pose[:2]),
+                                                       wrap_angle(pose[2] + turn)]))
+            else:
+                self._update_map(kind, *args)
+        self._pose = anchor.copy()
+        self.positions = self._map.positions

@@ -185,3 +185,48 @@ def test_a_blocked_drive_backs_off_and_side_steps(monkeypatch):
         move = c.decide(world.observation(2))
         assert move == expected
         world.move(move)
+
+
+def _episode(c, world: FakeWorld, start, goal: int) -> list[int]:
+    """Reset the controller, put the robot at ``start`` (world frame) and run to the
+    goal; the landmarks it stood at."""
+    c.reset(seed=int(100 * start[0]))
+    world.pose = np.array(start, dtype=float)
+    visited = []
+    for _ in range(400):
+        move = c.decide(world.observation(goal))
+        if c.at is not None and c.at not in visited[-1:]:
+            visited.append(c.at)
+        if move is None:
+            break
+        world.move(move)
+    return visited
+
+
+def _in_frame(origin, pose) -> np.ndarray:
+    """``pose`` (world) in the frame of a robot switched on at ``origin``."""
+    c, s = math.cos(origin[2]), math.sin(origin[2])
+    dx, dy = pose[0] - origin[0], pose[1] - origin[1]
+    return np.array([c * dx + s * dy, -s * dx + c * dy, wrap_angle(pose[2] - origin[2])])
+
+
+@pytest.mark.parametrize("planning", ["deterministic", "probabilistic"])
+def test_the_map_persists_across_the_episodes_of_a_world(monkeypatch, planning):
+    """memory="world": the second episode starts elsewhere, its odometry in a frame of its
+    own; the robot goes to landmark 0, where it stood in the first episode, takes that
+    anchor's pose (its pose is in the first episode's frame from then on) and the graph
+    goes on counting looks. memory="episode" starts afresh in the new frame."""
+    first, second = (0.5, 0.3, 0.4), (0.3, -0.3, 2.5)
+    for memory in ("world", "episode"):
+        world = FakeWorld(PANELS)
+        monkeypatch.setattr(selfsimilar, "detect_landmarks", world.detections)
+        monkeypatch.setattr(selfsimilar, "panel_pose", world.panel_pose)
+        c = homing_baselines.make("selfsimilar", planning=planning, memory=memory)
+        assert _episode(c, world, first, goal=2) == [0, 1, 2]
+        assert c.graph.edge(0, 1).looked == 1
+        assert _episode(c, world, second, goal=2) == [0, 1, 2]
+        origin = first if memory == "world" else second
+        assert np.allclose(c._pose, _in_frame(origin, world.pose), atol=0.15)
+        assert c.graph.edge(0, 1).looked == (2 if memory == "world" else 1)
+    with pytest.raises(ValueError, match="memory 'forever'"):
+        homing_baselines.make("selfsimilar", memory="forever")
