@@ -51,8 +51,9 @@ import numpy as np
 from homing_baselines.base import Controller
 from homing_baselines.bearing_laws import (LAWS, LawResult, UnifiedConfig, UnifiedLaw, basic_law,
                                     complementary_law, snapshots_similar)
-from homing_baselines.blobs import LAB_COLORS, BlobColor, detect_blobs, matched_bearings
+from homing_baselines.blobs import LAB_COLORS, Blob, BlobColor, detect_blobs
 from homing_baselines.motion import Move
+from homing_gym.geometry import wrap_angle
 from homing_gym.validation import require_positive
 
 #: Landmark colours a controller may use, by name.
@@ -112,8 +113,11 @@ class BearingController(BearingLawController):
 
     colors: tuple[str, ...] = ("red", "green", "blue")
     min_area: int = 4
+    occlusion_gap: float = 0.5
+    near_width: float = 0.45
 
     law: ClassVar[str] = "unified"
+    reads_at_decisions_only: ClassVar[bool] = True
 
     def validate(self) -> None:
         super().validate()
@@ -129,6 +133,8 @@ class BearingController(BearingLawController):
     def on_reset(self) -> None:
         self._unified = UnifiedLaw(self.unified_config())
         self.last_result: LawResult | None = None
+        self._all_seen: dict[str, float] | None = None
+        self._detour: dict[str, float] = {}
 
     def evaluate(self, current: np.ndarray, goal: np.ndarray) -> LawResult:
         """This controller's law on matched bearings (radians, CCW)."""
@@ -142,16 +148,63 @@ class BearingController(BearingLawController):
         palette = tuple(PALETTE[c] for c in self.colors)
         now = detect_blobs(observation["panorama"], palette, self.min_area)
         then = detect_blobs(observation["goal"], palette, self.min_area)
-        current, goal, _ = matched_bearings(now, then, self.colors)
-        if len(current) < 3:
+        seen = self.bearings_with_occluded(now)
+        target = goal_bearings(then, self.colors)
+        both = [c for c in self.colors if c in seen and c in target]
+        if len(both) < 3:
             return self.search_move()
+        current = np.array([seen[c] for c in both])
+        goal = np.array([target[c] for c in both])
         if snapshots_similar(current, goal, self.stop_tol):
             return None
         result = self.evaluate(current, goal)
         self.last_result = result
         if not math.isfinite(result.direction):
             return None
-        return self.move_along(result)
+        return self.around_columns(self.move_along(result), now, then)
+
+    def bearings_with_occluded(self, now: dict[str, Blob]) -> dict[str, float]:
+        """Bearings (radians) of the landmarks seen now, and of those hidden behind another
+        landmark's column: a landmark that was within ``occlusion_gap`` radians of a
+        landmark seen now, at the last decision that saw every colour, and is missing now
+        lies behind that column, so it takes the column's bearing (error below the
+        column's half-width). Remembers the bearings when every colour is seen."""
+        seen = {name: blob.bearing for name, blob in now.items()}
+        if len(seen) == len(self.colors):
+            self._all_seen = seen
+            return seen
+        last = self._all_seen
+        for name in (c for c in self.colors if c not in now and last is not None):
+            gaps = {k: abs(wrap_angle(last[name] - last[k])) for k in now}
+            if gaps and min(gaps.values()) <= self.occlusion_gap:
+                seen[name] = now[min(gaps, key=gaps.get)].bearing
+        return seen
+
+    def around_columns(self, move: Move, now: dict[str, Blob], then: dict[str, Blob]) -> Move:
+        """``move``, or a step round a landmark column in its way: when a column spans at
+        least ``near_width`` radians (it is near), more than it spans in the goal snapshot
+        (the goal is farther from it), and ``move`` has a component towards it, the
+        robot steps perpendicular to the column's bearing, on the side of ``move`` (kept
+        while the same column blocks), so it goes round the column instead of into it."""
+        for name, blob in now.items():
+            off = float(wrap_angle(move.direction - blob.bearing))
+            goal_width = then[name].width if name in then else 0.0
+            if blob.width >= max(self.near_width, goal_width) and abs(off) < math.pi / 2:
+                side = self._detour.get(name) or math.copysign(1.0, off)
+                self._detour = {name: side}
+                return Move(float(wrap_angle(blob.bearing + side * math.pi / 2)), move.distance)
+        self._detour = {}
+        return move
+
+def goal_bearings(goal: dict[str, Blob], colors: tuple[str, ...]) -> dict[str, float]:
+    """Bearings (radians) of the goal snapshot's landmarks. When exactly one colour is
+    missing and the others are seen, it is taken to be hidden behind the widest (nearest)
+    column seen, and takes that column's bearing: only a nearer column can hide it."""
+    bearings = {name: blob.bearing for name, blob in goal.items()}
+    missing = [c for c in colors if c not in goal]
+    if len(missing) == 1 and len(goal) >= 2:
+        bearings[missing[0]] = max(goal.values(), key=lambda b: b.width).bearing
+    return bearings
 
 
 @dataclass

@@ -68,13 +68,16 @@ LAB_COLORS: tuple[BlobColor, ...] = (BlobColor("red", 0), BlobColor("green", 60)
 class Blob:
     """One detected landmark: its colour ``name``, centroid column ``x`` in ``[0, W)`` and
     row ``y`` (pixels, continuous), ``bearing`` (radians, CCW from heading, in
-    ``(-pi, pi]``) and ``area`` (pixels)."""
+    ``(-pi, pi]``), ``area`` (pixels) and ``width``, the angle the blob spans (radians:
+    its columns times ``2 pi / W``; a column of radius ``r`` at distance ``d`` spans
+    ``2 asin(r / d)``)."""
 
     name: str
     x: float
     y: float
     bearing: float
     area: int
+    width: float
 
 
 def color_mask(panorama: np.ndarray, color: BlobColor) -> np.ndarray:
@@ -90,9 +93,9 @@ def color_mask(panorama: np.ndarray, color: BlobColor) -> np.ndarray:
     return ok.astype(np.uint8) * 255
 
 
-def largest_blob(mask: np.ndarray, min_area: int = 4) -> tuple[float, float, int] | None:
-    """Centroid ``(x, y)`` (continuous pixel coordinates, ``x`` in ``[0, W)``) and area of
-    the largest 8-connected component of a panorama mask, seam-aware (see the module
+def largest_blob(mask: np.ndarray, min_area: int = 4) -> tuple[float, float, int, int] | None:
+    """Centroid ``(x, y)`` (continuous pixel coordinates, ``x`` in ``[0, W)``), area and
+    width (columns) of the largest 8-connected component of a panorama mask, seam-aware (see the module
     docstring); ``None`` if there is none of ``min_area`` pixels or the mask fills every
     column."""
     W = mask.shape[1]
@@ -110,7 +113,7 @@ def largest_blob(mask: np.ndarray, min_area: int = 4) -> tuple[float, float, int
         return None
     ys, xs = np.nonzero(labels == k)
     x = (float(xs.mean()) + 0.5 + shift) % W
-    return x, float(ys.mean()) + 0.5, area
+    return x, float(ys.mean()) + 0.5, area, int(stats[k, cv2.CC_STAT_WIDTH])
 
 
 def detect_blobs(panorama: np.ndarray, colors: tuple[BlobColor, ...] = LAB_COLORS,
@@ -124,15 +127,7 @@ def detect_blobs(panorama: np.ndarray, colors: tuple[BlobColor, ...] = LAB_COLOR
     for color in colors:
         found = largest_blob(color_mask(panorama, color), min_area)
         if found is not None:
-            x, y, area = found
-            out[color.name] = Blob(color.name, x, y, wrap_angle(column_bearing(x, W)), area)
+            x, y, area, columns = found
+            out[color.name] = Blob(color.name, x, y, wrap_angle(column_bearing(x, W)), area,
+                                   2 * np.pi * columns / W)
     return out
-
-
-def matched_bearings(current: dict[str, Blob], goal: dict[str, Blob],
-                     names: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray, tuple[str, ...]]:
-    """Bearings (radians) of the landmarks seen in both snapshots, in the order of
-    ``names`` (identity by colour), and the names used."""
-    both = tuple(n for n in names if n in current and n in goal)
-    return (np.array([current[n].bearing for n in both]),
-            np.array([goal[n].bearing for n in both]), both)

@@ -6,7 +6,10 @@ import numpy as np
 import pytest
 
 import homing_baselines
+from homing_baselines.bearing import goal_bearings
 from homing_baselines.bearing_sim import region
+from homing_baselines.blobs import Blob
+from homing_baselines.motion import Move
 from homing_gym.envs import LocalHomingEnv
 from homing_gym.scenes import available_scenes, scene_factory
 from homing_gym.scenes.base import clearance
@@ -67,6 +70,60 @@ def test_basic_law_fails_where_the_complementary_law_succeeds(lab):
     comp, _ = _run(lab, "bearing-complementary", (0.6, 0.1, 1.0), "E")
     assert basic.final_distance > 0.5
     assert comp.terminated and comp.final_distance < 0.2
+
+
+def _blobs(**specs) -> dict[str, Blob]:
+    """Blobs by colour from ``name=(bearing, width)`` (radians)."""
+    return {name: Blob(name, 0.0, 0.0, bearing, 10, width) for name, (bearing, width)
+            in specs.items()}
+
+
+def test_a_landmark_hidden_behind_a_column_takes_the_column_bearing():
+    controller = homing_baselines.make("bearing")
+    controller.reset()
+    seen = controller.bearings_with_occluded(
+        _blobs(red=(1.0, 0.1), green=(1.2, 0.1), blue=(-2.0, 0.1)))
+    assert seen == {"red": 1.0, "green": 1.2, "blue": -2.0}
+    # red vanished next to green (0.2 rad apart): behind green's column
+    assert controller.bearings_with_occluded(_blobs(green=(1.1, 0.3), blue=(-2.1, 0.1))) \
+        == {"green": 1.1, "blue": -2.1, "red": 1.1}
+    # blue vanished far from every column: not occluded by one, still missing
+    assert "blue" not in controller.bearings_with_occluded(_blobs(red=(1.0, 0.1),
+                                                                  green=(1.2, 0.1)))
+
+
+def test_a_landmark_missing_in_the_goal_is_behind_the_nearest_column():
+    colors = ("red", "green", "blue")
+    assert goal_bearings(_blobs(red=(0.5, 0.1), blue=(2.0, 0.3)), colors) == \
+        {"red": 0.5, "blue": 2.0, "green": 2.0}
+    assert goal_bearings(_blobs(red=(0.5, 0.1)), colors) == {"red": 0.5}
+
+
+def test_the_robot_steps_round_a_near_column_in_its_way():
+    controller = homing_baselines.make("bearing")
+    controller.reset()
+    goal = _blobs(red=(0.0, 0.1))
+    near = _blobs(red=(0.0, 0.6))                       # 0.6 rad wide: about 0.33 m away
+    move = controller.around_columns(Move(0.2, 0.05), near, goal)
+    assert move == Move(np.pi / 2, 0.05)                 # perpendicular, on the move's side
+    assert controller.around_columns(Move(-0.1, 0.05), near, goal).direction == np.pi / 2
+    assert controller.around_columns(Move(2.0, 0.05), near, goal) == Move(2.0, 0.05)  # away
+    far = _blobs(red=(0.0, 0.2))
+    assert controller.around_columns(Move(0.2, 0.05), far, goal) == Move(0.2, 0.05)
+    # the goal is nearer the column than the robot: let the law approach it
+    assert controller.around_columns(Move(0.2, 0.05), near, _blobs(red=(0.0, 0.7))) \
+        == Move(0.2, 0.05)
+
+
+@pytest.mark.parametrize("start, goal", [
+    ((-1.795, -0.771, -0.195), "A"),   # behind L1: the straight way to A runs into it
+    ((0.33, 1.573, 1.291), "B"),       # L1 hidden behind L3 at the start
+])
+def test_unified_law_goes_round_and_past_the_columns(lab, start, goal):
+    """Fig. 11 runs that used to end pressed against a landmark column."""
+    record, _ = _run(lab, "bearing", start, goal)
+    assert record.collisions == 0
+    assert record.terminated and record.final_distance < 0.15
 
 
 def test_bearing_controllers_run_in_the_harness_from_the_observation_only():

@@ -9,7 +9,7 @@ import pytest
 from homing_baselines.blobs import LAB_COLORS, BlobColor, detect_blobs, largest_blob
 from homing_baselines.klt import CornerTracker, KLTConfig, wrap_columns
 from homing_gym.geometry import bearing_to, wrap_angle
-from homing_gym.scenes.lab import MARKED
+from homing_gym.scenes.lab import MARKED, POSTER_RADIUS
 
 
 @pytest.fixture(scope="module")
@@ -35,6 +35,16 @@ def test_blob_bearings_match_the_true_bearings_of_the_poster_columns(lab_env):
     assert np.median(errors) < 0.5 and errors.max() < 1.5   # 1.41 deg per column
 
 
+def test_blob_width_is_the_angle_the_column_spans(lab_env):
+    """A column of radius r at distance d spans 2 asin(r / d): within two columns."""
+    landmarks = lab_env.scene.metadata["landmarks"]
+    for x, y in MARKED.values():
+        blobs = detect_blobs(lab_env.render_panorama(np.array([x, y, 0.3])))
+        for name, point in landmarks.items():
+            truth = 2 * math.asin(POSTER_RADIUS / math.dist((x, y), point))
+            assert abs(blobs[name].width - truth) < 2 * 2 * math.pi / 256, name
+
+
 def test_blob_behind_the_robot_is_one_blob_across_the_seam(lab_env):
     red = lab_env.scene.metadata["landmarks"]["red"]
     x, y = 0.0, 0.5
@@ -52,8 +62,9 @@ def test_largest_blob_joins_the_two_halves_at_the_seam():
     mask[3:7, 61:] = 255
     mask[3:7, :2] = 255                                  # 5 columns around x = 0 = 64
     mask[1:3, 20:22] = 255                               # a smaller blob elsewhere
-    x, y, area = largest_blob(mask)
+    x, y, area, columns = largest_blob(mask)
     assert area == 20 and abs(wrap_columns(x - 63.5, 64)) < 1e-9 and y == 5.0
+    assert columns == 5                                  # across the seam
     assert largest_blob(np.full((4, 8), 255, np.uint8)) is None   # no empty column
 
 

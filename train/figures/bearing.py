@@ -31,6 +31,10 @@ the paper's numbers.
     python -m homing_train.figures.bearing pixel-reachability --out docs/bearing
     python -m homing_train.figures.bearing longrange --episodes 10 --out docs/bearing
 
+    python -m homing_train.figures.bearing lab-anywhere --episodes 40 --out docs/bearing
+
+``lab-anywhere`` runs the unified law to the env's own homes anywhere in the lab and
+asks the 2-D simulator whether each goal is reachable from its start.
 ``pixel-reachability`` is the Fig. 4 map measured from pixels: the three laws from one
 start to a coarse grid of goals in the lab (``pixel_reachability.png`` and ``.json``).
 ``longrange`` runs ``bearing-longrange`` (§3) on seeded ``LongRangeHoming-v0`` episodes
@@ -421,6 +425,51 @@ def pixel_reachability(out: str, spacing: float = 1.2, max_steps: int = 600,
     return fractions
 
 
+def lab_anywhere(out: str, episodes: int = 40, seed: int = 0, max_steps: int = 800,
+                 progress: bool = True) -> dict:
+    """The unified law (``bearing``) in ``LocalHoming-v0`` in the lab with the env's own
+    homes (anywhere in the room) and starts (0.3-1.5 m away), seeds ``seed`` ... ``seed +
+    episodes - 1``, a success being a stop within the env's 0.15 m. Each episode's start
+    and home are also run in the 2-D simulator (:func:`homing_baselines.bearing_sim.simulate`,
+    the lab's landmark points, ideal bearings): the goal is *reachable* when the unified
+    law reaches it there. Writes ``lab_anywhere.json``; returns the counts."""
+    import gymnasium as gym
+
+    import homing_baselines
+    import homing_gym
+    from homing_baselines.bearing_sim import simulate
+    from homing_gym.scenes.lab import POSTERS
+    from homing_train.harness.evaluate import run_episode
+    from homing_train.harness.rollout import prepare_policy
+
+    gym.register_envs(homing_gym)
+    env = gym.make("homing_gym/LocalHoming-v0", scene="lab", success_on="stop",
+                   max_episode_steps=max_steps, **MEASURED_WITH)
+    triangle = np.array([pos for _, pos in POSTERS.values()])
+    controller = homing_baselines.make("bearing")
+    prepare_policy(controller, env)
+    runs = []
+    for s in tqdm(range(seed, seed + episodes), desc="lab, homes anywhere",
+                  disable=not progress):
+        record = run_episode(env, controller, s)
+        start, home = np.array(record.start_pose[:2]), np.array(record.home_pose[:2])
+        runs.append({"seed": s, "start": record.start_pose, "home": record.home_pose,
+                     "region": str(region(triangle, home)),
+                     "reachable": simulate(triangle, start, home).success,
+                     "success": record.success, "stopped": record.terminated,
+                     "error_cm": round(100 * record.final_distance, 1),
+                     "steps": record.steps, "collisions": record.collisions})
+    env.close()
+    reach = [r for r in runs if r["reachable"]]
+    counts = {"episodes": len(runs), "success": sum(r["success"] for r in runs),
+              "reachable": len(reach), "success_reachable": sum(r["success"] for r in reach)}
+    os.makedirs(out, exist_ok=True)
+    with open(os.path.join(out, "lab_anywhere.json"), "w") as f:
+        json.dump({"seed": seed, "max_steps": max_steps, "counts": counts, "runs": runs}, f,
+                  indent=1)
+    return counts
+
+
 def longrange(out: str, episodes: int = 10, seed: int = 0, route_length: float = 8.0,
               progress: bool = True) -> list[dict]:
     """``bearing-longrange`` on ``LongRangeHoming-v0`` (lab, ``success_on="stop"``: a
@@ -483,6 +532,8 @@ def main(argv: list[str] | None = None) -> int:
     f11.add_argument("--out", default="docs/bearing", help="output folder")
     f11.add_argument("--runs", type=int, default=30, help="runs per marked position")
     f11.add_argument("--max-steps", type=int, default=800)
+    f11.add_argument("--seed", type=int, default=11,
+                     help="seed of the starts (11: the documented table; others: fresh starts)")
     f11.add_argument("--no-progress", action="store_true")
     pr = sub.add_parser("pixel-reachability",
                         help="reachability of the three laws from pixels in the lab")
@@ -491,6 +542,13 @@ def main(argv: list[str] | None = None) -> int:
     pr.add_argument("--max-steps", type=int, default=600)
     pr.add_argument("--fail-cm", type=float, default=20.0)
     pr.add_argument("--no-progress", action="store_true")
+    la = sub.add_parser("lab-anywhere",
+                        help="the unified law in the lab, homes anywhere, with 2-D reachability")
+    la.add_argument("--out", default="docs/bearing", help="output folder")
+    la.add_argument("--episodes", type=int, default=40)
+    la.add_argument("--seed", type=int, default=0, help="seed of the first episode")
+    la.add_argument("--max-steps", type=int, default=800)
+    la.add_argument("--no-progress", action="store_true")
     lr = sub.add_parser("longrange", help="bearing-longrange on LongRangeHoming-v0")
     lr.add_argument("--out", default="docs/bearing", help="output folder")
     lr.add_argument("--episodes", type=int, default=10)
@@ -506,11 +564,15 @@ def main(argv: list[str] | None = None) -> int:
         rows = longrange(args.out, args.episodes, args.seed, args.route_length,
                          progress=not args.no_progress)
         print(f"success {sum(r['success'] for r in rows)}/{len(rows)}")
+    elif args.command == "lab-anywhere":
+        counts = lab_anywhere(args.out, args.episodes, args.seed, args.max_steps,
+                              progress=not args.no_progress)
+        print(json.dumps(counts))
     elif args.command == "fig10":
         runs = fig10(args.out, args.max_steps, args.fail_cm, progress=not args.no_progress)
         print(fig10_table(runs, args.fail_cm))
     elif args.command == "fig11":
-        print(fig11_table(fig11(args.out, args.runs, args.max_steps,
+        print(fig11_table(fig11(args.out, args.runs, args.max_steps, args.seed,
                                 progress=not args.no_progress)))
     elif args.command == "reachability":
         fractions = reachability(args.out, args.grid, args.extent, args.start,
