@@ -7,22 +7,36 @@
 (2-2) from that heading and the positions (1-3), predict where each characteristic
       point should appear in the current full-resolution view;
 (2-3) search each high-resolution template (1-2) by normalised correlation only in a
-      small window around its prediction (this also keeps look-alike points, problem
-      (b-2), from being confused);
+      window around its prediction (this also keeps look-alike points, problem (b-2),
+      from being confused);
 
 then, with two or more rediscovered points, compute position and heading from their
 known 3-D coordinates and apparent directions (:func:`~homing_baselines.multires_matching.triangulate`).
 
-Choices where the paper is silent: the apparent direction of a point is its bearing
-*and* its elevation (with the camera height known, two points then fix the pose); the
-first windows are ``coarse_radius`` wide because the heading is known only to a
-low-resolution column and parallax moves near points; a second pass predicts every
-point from the first pose estimate and searches again in ``fine_radius`` windows; a
-pose is fitted to the pair of points that most other points agree with (within
-``outlier`` radians; all pairs are tried, there are at most 45) and refitted on those, and
-a pose more than ``max_offset`` from the work location
-is rejected. The view correlated in (2-1) is the whole low-resolution panorama (the
-robot's camera sees all around; the paper's robot turned its head instead, Fig. 6).
+Choices where the paper is silent (§3(2) gives no window sizes, scales or robust
+estimator; §4(2-2) claims < 10 cm and < 2 deg "within 50 centimeters" of the taught
+point, so the search is sized for that range, ``reach`` = 0.5 m):
+
+* the apparent direction of a point is its bearing *and* its elevation (with the
+  camera height known, two points then fix the pose);
+* (2-3) windows: the prediction (2-2) is exact only at the taught point; from anywhere
+  within ``reach`` a point at distance ``d`` appears up to ``asin(reach/d)`` away in
+  bearing and correspondingly in elevation (parallax, :func:`parallax_windows`: about
+  +-45 columns for a point 1 m away, +-16 for one 3.5 m away), plus ``margin`` for the
+  low-resolution heading; and up to ``d/(d-reach)`` times larger or ``d/(d+reach)``
+  smaller, so each template is also tried at the powers of 2^(1/4) in that range
+  (:func:`search_scales`; the paper's own arrival decision, Fig. 5, compares enlarged
+  and reduced images the same way) and the best correlation counts;
+* the pose is fitted to the pair of points that most others agree with (within
+  ``outlier`` radians; all pairs are tried, there are at most 45; among equally many,
+  the smallest sum of residuals) and refitted on those; a pose more than
+  ``max_offset`` from the work location is rejected;
+* ``fine_passes`` times, every point is predicted from the last pose, its template
+  resized to the size it has from there (taught over predicted distance), and searched
+  again in ``fine_radius`` windows; the pose is refitted on what is found (the paper's
+  robot kept tracking its points, Figs. 6-7);
+* the view correlated in (2-1) is the whole low-resolution panorama (the robot's
+  camera sees all around; the paper's robot turned its head instead, Fig. 6).
 """
 
 from __future__ import annotations
@@ -30,6 +44,7 @@ from __future__ import annotations
 import itertools
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
 
 from homing_baselines.multires_matching import (find_template, front_view, match_heading,
@@ -44,16 +59,20 @@ from homing_gym.vision import grey, low_resolution
 class LocaliseConfig:
     """Camera calibration (``camera_height`` m, ``vfov`` rad), the width ``fov`` (rad) of
     the view correlated in (2-1) (default the whole panorama: the robot's camera sees
-    all around, where the paper's robot turned its head), search windows (half sizes in full-resolution pixels: columns, rows), the
-    normalised-correlation ``threshold`` of a rediscovery, the ``outlier`` residual
-    (rad) and ``max_offset`` (m): a pose further than this from the work location is
-    rejected as a false rediscovery."""
+    all around, where the paper's robot turned its head), ``reach`` (m): how far from
+    the work location the robot may stand (it sizes the first windows and scales),
+    ``margin`` and ``fine_radius`` (half sizes in full-resolution pixels: columns,
+    rows), ``fine_passes``, the normalised-correlation ``threshold`` of a
+    rediscovery, the ``outlier`` residual (rad) and ``max_offset`` (m): a pose further
+    than this from the work location is rejected as a false rediscovery."""
 
     camera_height: float = 0.30
     vfov: float = np.radians(60.0)
     fov: float = 2 * np.pi
-    coarse_radius: tuple[int, int] = (24, 8)
+    reach: float = 0.5
+    margin: tuple[int, int] = (4, 2)
     fine_radius: tuple[int, int] = (4, 3)
+    fine_passes: int = 3
     threshold: float = 0.6
     outlier: float = np.radians(1.5)
     max_offset: float = 0.75
@@ -70,11 +89,59 @@ class Localisation:
     found: int
 
 
-def _search(image: np.ndarray, fmap: FeatureMap, columns: np.ndarray, rows: np.ndarray,
-            radius: tuple[int, int], threshold: float):
+def _distances(fmap: FeatureMap, xy) -> np.ndarray:
+    """Horizontal distance (m) of each characteristic point from ``xy``."""
+    return np.hypot(*(fmap.points[:, :2] - np.asarray(xy, np.float64)[:2]).T)
+
+
+def parallax_windows(fmap: FeatureMap, shape, config: LocaliseConfig) -> np.ndarray:
+    """Half sizes ``(N, 2)`` (full-resolution columns, rows) of the first (2-3) search
+    windows: how far each point's image can move from its taught position (1-3) when the
+    robot stands anywhere within ``reach`` metres of the work location, plus ``margin``."""
+    H, W = shape
+    d = _distances(fmap, fmap.pose)
+    rise = fmap.points[:, 2] - config.camera_height
+    near = np.maximum(d - config.reach, 0.5 * d)
+    bearing = np.arcsin(np.minimum(1.0, config.reach / d))
+    elevation = np.maximum(np.abs(np.arctan2(rise, near) - np.arctan2(rise, d)),
+                           np.abs(np.arctan2(rise, d + config.reach) - np.arctan2(rise, d)))
+    return np.column_stack([np.ceil(bearing * W / (2 * np.pi)) + config.margin[0],
+                            np.ceil(elevation * H / config.vfov) + config.margin[1]]).astype(int)
+
+
+def search_scales(fmap: FeatureMap, config: LocaliseConfig) -> list[list[float]]:
+    """For each point, the enlargements 2^(k/4) (k = -4..4) its template is tried at in
+    the first search: every size it can appear at from ``reach`` metres further away to
+    ``reach`` closer (at most twice as close) is within half a step of one of them."""
+    d = _distances(fmap, fmap.pose)
+    steps = 2.0 ** (np.arange(-4, 5) / 4)
+    half = 2.0 ** (1 / 8)
+    return [[float(s) for s in steps
+             if dist / (dist + config.reach) / half <= s
+             <= dist / max(dist - config.reach, dist / 2) * half]
+            for dist in d]
+
+
+def resized(template: np.ndarray, scale: float) -> np.ndarray:
+    """``template`` enlarged ``scale`` times about its centre, to the nearest odd size."""
+    size = 2 * int(round(template.shape[0] * scale / 2)) + 1
+    if size == template.shape[0]:
+        return template
+    interpolation = cv2.INTER_AREA if size < template.shape[0] else cv2.INTER_LINEAR
+    return cv2.resize(template, (size, size), interpolation=interpolation)
+
+
+def _search(image: np.ndarray, templates: list[list[np.ndarray]], columns, rows,
+            radius, threshold: float) -> list[tuple[int, float, float]]:
+    """``[(point index, x, y)]`` of the points whose best template (of each point's
+    ``templates``) correlates at least ``threshold`` within ``radius`` (one ``(columns,
+    rows)`` or one per point) of its predicted ``(columns, rows)``."""
     found = []
+    radii = np.broadcast_to(np.asarray(radius, int), (len(columns), 2))
     for k, (x, y) in enumerate(zip(columns, rows)):
-        match = find_template(image, fmap.templates[k], float(x), float(y), radius)
+        matches = [m for m in (find_template(image, t, float(x), float(y), tuple(radii[k]))
+                               for t in templates[k]) if m is not None]
+        match = max(matches, key=lambda m: m.score, default=None)
         if match is not None and match.score >= threshold:
             found.append((k, match.x, match.y))
     return found
@@ -96,20 +163,22 @@ def _errors(pose, found, fmap: FeatureMap, shape, config: LocaliseConfig) -> np.
 
 def _fit(found, fmap: FeatureMap, shape, config: LocaliseConfig, guess):
     """Triangulate from ``found`` = [(point index, x, y)]: the pose of the pair of points
-    that most others agree with (within ``outlier``), refitted on all that agree;
-    ``(None, [])`` with fewer than two points or a pose beyond ``max_offset``."""
+    that most others agree with (within ``outlier``; among equally many, the smallest
+    sum of residuals), refitted on all that agree; ``(None, [])`` with fewer than two
+    points or a pose beyond ``max_offset``."""
     def solve(subset):
         bearings, elevations = _directions(subset, shape, config.vfov)
         return triangulate(fmap.points[[k for k, _, _ in subset]], bearings, elevations,
                            config.camera_height, guess)
 
     best: list = []
+    best_key = (0, 0.0)
     for a, b in itertools.combinations(range(len(found)), 2):
-        pose = solve([found[a], found[b]])
-        inliers = [f for f, e in zip(found, _errors(pose, found, fmap, shape, config))
-                   if e <= config.outlier]
-        if len(inliers) > len(best):
-            best = inliers
+        errors = _errors(solve([found[a], found[b]]), found, fmap, shape, config)
+        agree = errors <= config.outlier
+        key = (int(np.sum(agree)), -float(np.sum(errors[agree])))
+        if key > best_key:
+            best, best_key = [f for f, ok in zip(found, agree) if ok], key
     if len(best) < 2:
         return None, []
     pose = solve(best)
@@ -130,15 +199,22 @@ def localise(panorama: np.ndarray, fmap: FeatureMap,
     columns = (fmap.template_xy[:, 0] * scale + heading * W / (2 * np.pi)) % W
     rows = fmap.template_xy[:, 1] * scale
     guess = np.array([fmap.pose[0], fmap.pose[1], fmap.pose[2] + heading], np.float64)
-    found = _search(image, fmap, columns, rows, config.coarse_radius, config.threshold)
+    templates = [[resized(t, s) for s in scales]
+                 for t, scales in zip(fmap.templates, search_scales(fmap, config))]
+    found = _search(image, templates, columns, rows, parallax_windows(fmap, (H, W), config),
+                    config.threshold)
     pose, used = _fit(found, fmap, (H, W), config, guess)
     if pose is None:
         return Localisation(None, heading, len(found))
-    bearings, elevations = predicted_directions(pose, fmap.points, config.camera_height)
-    columns = bearing_column(bearings, W)
-    rows = (config.vfov / 2 - elevations) / config.vfov * H
-    found = _search(image, fmap, columns, rows, config.fine_radius, config.threshold)
-    refined, fine = _fit(found, fmap, (H, W), config, pose)
-    if refined is None:
-        return Localisation(pose, heading, len(used))
-    return Localisation(refined, heading, len(fine))
+    for _ in range(config.fine_passes):
+        bearings, elevations = predicted_directions(pose, fmap.points, config.camera_height)
+        columns = bearing_column(bearings, W)
+        rows = (config.vfov / 2 - elevations) / config.vfov * H
+        ratios = _distances(fmap, fmap.pose) / _distances(fmap, pose)
+        templates = [[resized(t, r)] for t, r in zip(fmap.templates, ratios)]
+        found = _search(image, templates, columns, rows, config.fine_radius, config.threshold)
+        refined, fine = _fit(found, fmap, (H, W), config, pose)
+        if refined is None:
+            break
+        pose, used = refined, fine
+    return Localisation(pose, heading, len(used))

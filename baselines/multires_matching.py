@@ -134,24 +134,25 @@ def find_template(image: np.ndarray, template: np.ndarray, x: float, y: float,
                   radius: tuple[int, int]) -> TemplateMatch | None:
     """Search grey ``template`` (odd size) in the grey panorama ``image`` with its centre
     within ``radius = (columns, rows)`` of the continuous point ``(x, y)`` (columns
-    wrap). ``None`` if the window leaves the image's rows."""
+    wrap); rows of the window beyond the image are cut off (the template stays inside
+    the image). ``None`` if no row of the window keeps the template inside."""
     t = template.shape[0]
     H, W = image.shape[:2]
     rx, ry = radius
     r = t // 2
     cx, cy = int(math.floor(x)), int(math.floor(y))
-    top, bottom = cy - ry - r, cy + ry + r + 1
-    if top < 0 or bottom > H:
+    first, last = max(cy - ry, r), min(cy + ry, H - 1 - r)     # rows of the centre
+    if first > last:
         return None
     pad = rx + r + 1
     left = cx - rx - r + pad
-    window = _wrap_pad(image, pad)[top:bottom, left:left + 2 * rx + t]
+    window = _wrap_pad(image, pad)[first - r:last + r + 1, left:left + 2 * rx + t]
     scores = cv2.matchTemplate(window.astype(np.float32), template.astype(np.float32),
                                cv2.TM_CCOEFF_NORMED)
     j, i = np.unravel_index(int(np.argmax(scores)), scores.shape)
     dx = _subpixel(scores[j, :], i)
     dy = _subpixel(scores[:, i], j)
-    return TemplateMatch(x=float((cx - rx + i + dx + 0.5) % W), y=float(cy - ry + j + dy + 0.5),
+    return TemplateMatch(x=float((cx - rx + i + dx + 0.5) % W), y=float(first + j + dy + 0.5),
                          score=float(scores[j, i]))
 
 

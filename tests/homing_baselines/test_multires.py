@@ -56,7 +56,58 @@ def test_template_found_at_its_subpixel_position_only_inside_the_window():
     assert match.score > 0.97
     assert abs(match.x - 200.3) < 0.25 and abs(match.y - 30.6) < 0.25
     assert find_template(image, template, 300.0, 33.0, (8, 5)).score < 0.7
-    assert find_template(image, template, 200.0, 3.0, (8, 5)) is None
+
+
+def test_window_beyond_the_top_is_cut_off_not_refused():
+    image = _panorama(2, (64, 512))
+    template = clip_template(image, 100.5, 9.5, 17)            # one row below the limit
+    match = find_template(image, template, 100.5, 4.0, (4, 8))  # centre rows -4..12
+    assert match is not None and match.score > 0.97
+    assert abs(match.y - 9.5) < 0.25
+    assert find_template(image, template, 100.5, 3.0, (4, 2)) is None  # no row keeps it in
+
+
+def _feature_map(points, pose=(0.0, 0.0, 0.0)):
+    from homing_gym.teaching import FeatureMap
+
+    n = len(points)
+    return FeatureMap(np.zeros((16, 128), np.uint8), np.zeros((n, 17, 17), np.uint8),
+                      np.zeros((n, 2), np.float32), np.asarray(points, np.float64),
+                      np.asarray(pose, np.float64), 2)
+
+
+def test_first_windows_cover_every_position_within_reach():
+    from homing_baselines.multires_localise import LocaliseConfig, parallax_windows
+
+    config = LocaliseConfig()
+    points = np.array([[1.0, 0.0, 0.5], [0.0, -3.5, 0.7], [-1.5, 1.5, 0.9]])
+    fmap = _feature_map(points)
+    H, W = 64, 512
+    windows = parallax_windows(fmap, (H, W), config)
+    assert windows[0, 0] > windows[2, 0] > windows[1, 0]       # nearer: wider
+    taught_b, taught_e = predicted_directions(fmap.pose, points, config.camera_height)
+    rng = np.random.default_rng(0)
+    for _ in range(200):
+        r, a = config.reach * math.sqrt(rng.uniform()), rng.uniform(-math.pi, math.pi)
+        pose = (r * math.cos(a), r * math.sin(a), 0.0)
+        b, e = predicted_directions(pose, points, config.camera_height)
+        columns = np.abs(np.remainder(b - taught_b + math.pi, 2 * math.pi) - math.pi) * W / (2 * math.pi)
+        rows = np.abs(e - taught_e) * H / config.vfov
+        assert np.all(columns <= windows[:, 0]) and np.all(rows <= windows[:, 1])
+
+
+def test_search_scales_span_the_sizes_seen_within_reach():
+    from homing_baselines.multires_localise import LocaliseConfig, search_scales
+
+    config = LocaliseConfig()
+    distances = [0.9, 1.4, 2.5, 4.0]
+    tried = search_scales(_feature_map([[d, 0.0, 0.5] for d in distances]), config)
+    for d, scales in zip(distances, tried):
+        seen = d / np.linspace(max(d - config.reach, d / 2), d + config.reach, 50)
+        nearest = np.min(np.abs(np.log2(seen[:, None] / np.array(scales)[None])), axis=1)
+        assert np.all(nearest <= 1 / 8 + 1e-9)                  # within half a step
+        assert len(scales) <= 9
+    assert len(tried[3]) < len(tried[0])
 
 
 @pytest.mark.parametrize("goal, start", [("kitchen", (5.5, 4.55, 0.1)),
