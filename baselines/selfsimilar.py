@@ -257,7 +257,9 @@ class SelfSimilarController(Controller):
         #: landmark the robot stands at (``None`` between landmarks).
         self.graph = self._map.graph
         self.explored = self._map.explored
-        self._localised = not self._map.standing  # an empty map: this episode's frame
+        self._localised = not self._map.standing  # no anchor: this episode's frame ...
+        if self._localised:                       # ... and nothing ties the last one to it
+            self._map.positions.clear()
         self._unmapped: list[tuple] = []         # graph updates held until localised
         self._pose = np.zeros(3)                 # dead-reckoned (x, y, heading), own frame
         self._odometry: np.ndarray | None = None
@@ -418,10 +420,11 @@ class SelfSimilarController(Controller):
         to the goal if seen, else the nearest one (§4.2): an anchor of the map if any is
         seen and the robot is not localised, else one not scanned from yet if any is
         seen; with nothing seen dead reckoning or wander."""
+        seen = {b: s for b, s in seen.items() if b != self.at}
         if not seen:
             return self._reckon_or_wander(goal)
         anchors = [] if self._localised else [b for b in seen if b in self._map.standing]
-        options = anchors or [b for b in seen if b not in self.explored] or list(seen)
+        options = anchors or [b for b in seen if b not in self._scanned()] or list(seen)
         target = goal if goal in seen else min(options, key=lambda b: seen[b].distance)
         self._came_from = self.at
         return self._head_for(target, seen[target])
@@ -469,7 +472,7 @@ class SelfSimilarController(Controller):
         wander."""
         here = {self.at} if self.at is not None else set()
         for options in (self._reaching(goal) - here,
-                        set(self.positions) - self.explored - self._lost - here):
+                        set(self.positions) - self._scanned() - self._lost - here):
             if options:
                 return self._reckon_to(options)
         return self._wander()
@@ -490,6 +493,10 @@ class SelfSimilarController(Controller):
         if self._scans_here < MAX_SCANS_HERE:
             return self._start_scan(goal)
         return self._reckon_or_wander(goal)
+
+    def _scanned(self) -> set[int]:
+        """The landmarks scanned from: the map's, and this episode's held back."""
+        return self.explored | {op[1] for op in self._unmapped if op[0] == "observe"}
 
     def _wander(self) -> Move:
         """Nothing to go to: ``wander_distance`` in a random direction."""

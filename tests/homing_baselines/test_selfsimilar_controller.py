@@ -230,3 +230,31 @@ def test_the_map_persists_across_the_episodes_of_a_world(monkeypatch, planning):
         assert c.graph.edge(0, 1).looked == (2 if memory == "world" else 1)
     with pytest.raises(ValueError, match="memory 'forever'"):
         homing_baselines.make("selfsimilar", memory="forever")
+
+
+def test_the_harness_names_the_world_and_each_world_keeps_its_own_map(make_env,
+                                                                       controller_for):
+    """The harness prepares the controller with its env: the controller notes the scene's
+    name (and keeps no handle on the env); resets keep that world's map, another world
+    gets another, and memory="episode" starts every episode afresh."""
+    env = make_env("homing_gym/LandmarkNavigation-v0",
+                   obs_keys=("view", "goal_id", "odometry"))
+    c = controller_for("selfsimilar", env)
+    c.reset(seed=0)
+    assert c._world == "corridors" and not any(v is env for v in vars(c).values())
+    corridors = c.graph
+    corridors.observe(0, {1: (2.0, 0.5)})
+    c.reset(seed=1)
+    assert c.graph is corridors and c.graph.edge(0, 1).looked == 1
+    c._world = "elsewhere"
+    c.reset(seed=2)
+    assert c.graph is not corridors and c.graph.graph.number_of_nodes() == 0
+    c._world = "corridors"
+    c.reset(seed=3)
+    assert c.graph is corridors
+    fresh = homing_baselines.make("selfsimilar", memory="episode")
+    fresh.reset(seed=0)
+    first = fresh.graph
+    first.observe(0, {1: (2.0, 0.5)})
+    fresh.reset(seed=1)
+    assert fresh.graph is not first and fresh.graph.edge(0, 1) is None

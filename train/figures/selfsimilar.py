@@ -4,6 +4,7 @@
     python -m homing_train.figures.selfsimilar detection --out docs/selfsimilar
     python -m homing_train.figures.selfsimilar layout --out docs/selfsimilar
     python -m homing_train.figures.selfsimilar nav --runs RUNS --out docs/selfsimilar
+    python -m homing_train.figures.selfsimilar memory --runs RUNS --out docs/selfsimilar
 
 ``speed``: detector frame rate on one core at 640 x 480 and 320 x 240 (the paper's
 sizes), with and without the §3.3 speed-ups (every 2k-th scanline first; peak scan
@@ -33,6 +34,14 @@ of seeds, ``RUNS/nav_<planning>_<clean|changed>_s<first seed>.json``, into
 ``nav_<planning>_<clean|changed>.json`` (+ .csv) under ``--out`` and prints the
 results table: success with its 95 % bootstrap interval (:func:`homing_train.harness.metrics.bootstrap_ci`),
 median path length and shortest path of the successes, steps, collisions.
+
+``memory``: the map kept across episodes (``memory="world"``) against a map per episode.
+Reads ``RUNS/seq_<planning>_<clean|changed>.json``, each one ``homing-eval`` run of
+``--param memory=world`` over a sequence of seeds with ``--workers 1`` (one controller,
+so one map, for the whole sequence), copies them under ``--out`` and prints them beside
+the per-episode runs (``nav_<planning>_<condition>.json``, merged by ``nav``, from
+``RUNS`` or else from ``--out``): success, successes per block of 10 episodes of the
+sequence, SPL, median path length over the shortest path of the successes, steps.
 """
 
 from __future__ import annotations
@@ -350,19 +359,74 @@ def nav_table(merged: dict) -> str:
     return "\n".join(lines)
 
 
+def memory_results(runs: str, out: str) -> dict:
+    """``{(planning, condition, memory): EvalResult}``: the sequences (``memory`` "world")
+    in ``runs``, saved under ``out``, and the per-episode runs ("episode") merged from
+    ``runs``, or those under ``out``."""
+    from homing_train.harness.evaluate import EvalResult
+
+    results = {}
+    per_episode = merge_nav_runs(runs, out) or {
+        (p, c): EvalResult.load(path) for p in PLANNINGS for c in CONDITIONS
+        for path in [os.path.join(out, f"nav_{p}_{c}.json")] if os.path.exists(path)}
+    for (planning, condition), result in per_episode.items():
+        results[(planning, condition, "episode")] = result
+    for planning in PLANNINGS:
+        for condition in CONDITIONS:
+            path = os.path.join(runs, f"seq_{planning}_{condition}.json")
+            if os.path.exists(path):
+                result = EvalResult.load(path)
+                result.save(os.path.join(out, f"seq_{planning}_{condition}.json"))
+                results[(planning, condition, "world")] = result
+    return results
+
+
+def memory_table(results: dict, block: int = 10) -> str:
+    """Markdown table of :func:`memory_results`, one row per planning, condition and
+    memory, ordered so that the two memories of a configuration stand together."""
+    lines = ["| planning | landmarks | map | episodes (seeds) | success % [95% CI] | "
+             f"successes per {block} episodes | SPL | path / shortest, median of successes "
+             "| steps, median |", "|---|---|---|---:|---:|---|---:|---:|---:|"]
+    for key in sorted(results, key=lambda k: (PLANNINGS.index(k[0]), CONDITIONS.index(k[1]),
+                                              k[2] == "world")):
+        planning, condition, memory = key
+        r = results[key]
+        episodes = sorted(r.episodes, key=lambda e: e.seed)
+        ok = np.array([e.success for e in episodes])
+        blocks = ", ".join(str(int(ok[i:i + block].sum())) for i in range(0, ok.size, block))
+        ratio = [e.path_length / e.shortest_path for e in episodes
+                 if e.success and e.shortest_path > 0]
+        lo, hi = r.summary["success_ci"]
+        land = "all, unoccluded" if condition == "clean" else "20 % removed, 30 % occluded"
+        kept = "kept across episodes" if memory == "world" else "per episode"
+        lines.append(
+            f"| {planning} | {land} | {kept} | {ok.size} ({episodes[0].seed}-"
+            f"{episodes[-1].seed}) | {100 * ok.mean():.0f} [{100 * lo:.0f}, {100 * hi:.0f}] "
+            f"| {blocks} | {r.summary['spl']:.2f} | "
+            f"{np.median(ratio) if ratio else math.nan:.2f} | "
+            f"{np.median([e.steps for e in episodes]):.0f} |")
+    return "\n".join(lines)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = command_parser("python -m homing_train.figures.selfsimilar", __doc__)
-    parser.add_argument("what", choices=["speed", "detection", "layout", "nav"])
-    parser.add_argument("--runs", help="nav: folder of the chunked homing-eval results")
+    parser.add_argument("what", choices=["speed", "detection", "layout", "nav", "memory"])
+    parser.add_argument("--runs", help="nav, memory: folder of the homing-eval results")
     parser.add_argument("--out", default="docs/selfsimilar")
     parser.add_argument("--repeats", type=int, default=200)
     args = parser.parse_args(argv)
     if args.repeats < 1:
         parser.error(f"--repeats must be >= 1, got {args.repeats}")
     os.makedirs(args.out, exist_ok=True)
+    if args.what in ("nav", "memory") and not args.runs:
+        parser.error(f"{args.what} needs --runs FOLDER")
+    if args.what == "memory":
+        results = memory_results(args.runs, args.out)
+        if not any(k[2] == "world" for k in results):
+            parser.error(f"no seq_<planning>_<condition>.json in {args.runs!r}")
+        print(memory_table(results))
+        return 0
     if args.what == "nav":
-        if not args.runs:
-            parser.error("nav needs --runs FOLDER")
         merged = merge_nav_runs(args.runs, args.out)
         if not merged:
             parser.error(f"no nav_<planning>_<condition>_s<seed>.json in {args.runs!r}")
