@@ -43,6 +43,16 @@ Choices where the paper is open (also in ``docs/bearing.md``):
   ``inlier_fraction`` = 0.5, i.e. the median residual: met 3-15 cm from an MP in the lab.
   Asking 80% within 0.03 rad was never met near some MPs: a fifth of the tracks had
   drifted or been registered onto a neighbouring corner.
+* **Mistracked features are left out of the law.** The law sums ``M_ij`` over every
+  pair, so one feature whose bearing is wrong (a track that slid onto a neighbouring
+  corner, or was registered onto one in the bricks' repeated texture) enters ``N - 1``
+  pairs and, near the MP where the true ``Delta theta`` vanish, sets the direction: the
+  robot dithered 15-20 cm from an MP with random directions (seed 104). §3 estimates
+  ``phi`` with the median "for robustness" because of such tracking errors; in the same
+  spirit a feature whose residual ``|A_P(F_i) - A_P'(F_i) - phi|`` exceeds
+  ``outlier_factor`` (3) times the median residual (and ``stop_tol``) is left out of the
+  law at that decision. Far from the MP the residuals are spread by parallax and few
+  are left out; near it the consistent features agree and the outliers stand out.
 * A leg's feature set shrinks as tracks are lost; Algorithm 1 needs the same landmarks at
   every step, so its state restarts whenever the set changes. With corners all around,
   criterion 1 (goal inside their hull) decides BASIC at once, so little is lost.
@@ -121,13 +131,16 @@ def median_offset(offsets: np.ndarray) -> float:
 class LongRangeBearingController(BearingLawController):
     """Long-range homing (module docstring). Parameters: ``min_shared`` (features that
     consecutive milestones share, 3 to ``klt.max_features``), ``inlier_fraction`` (of a
-    leg's live features that must agree with ``phi`` to arrive), ``klt``
+    leg's live features that must agree with ``phi`` to arrive), ``outlier_factor``
+    (features whose offset residual exceeds this many times the median residual are left
+    out of the law), ``klt``
     (:class:`~homing_baselines.klt.KLTConfig`) and those of
     :class:`~homing_baselines.bearing.BearingLawController` (``stop_tol``: the arrival tolerance
     on each feature's offset from ``phi``, radians)."""
 
     min_shared: int = 80
     inlier_fraction: float = 0.5
+    outlier_factor: float = 3.0
     stop_tol: float = 0.02
     klt: KLTConfig = field(default_factory=KLTConfig)
 
@@ -145,6 +158,8 @@ class LongRangeBearingController(BearingLawController):
                              f"got {self.min_shared!r}")
         if not 0 < self.inlier_fraction <= 1:
             raise ValueError(f"inlier_fraction must be in (0, 1], got {self.inlier_fraction!r}")
+        if not (math.isfinite(self.outlier_factor) and self.outlier_factor >= 1):
+            raise ValueError(f"outlier_factor must be finite and >= 1, got {self.outlier_factor!r}")
 
     def observation_keys(self) -> tuple[str, ...]:
         return ("panorama", "phase")
@@ -215,13 +230,16 @@ class LongRangeBearingController(BearingLawController):
             return self.search_move()
         offsets = wrap_angle(target - current)
         self.phi = median_offset(offsets)
-        if np.mean(np.abs(wrap_angle(offsets - self.phi)) <= self.stop_tol) \
-                >= self.inlier_fraction:
+        residual = np.abs(wrap_angle(offsets - self.phi))
+        if np.mean(residual <= self.stop_tol) >= self.inlier_fraction:
             if self.leg == len(self.milestones) - 1:   # home: turn to its heading, stop
                 self._home = True
                 return Move(float(wrap_angle(-self.phi)), 0.0)
             self._arrive()
             return self.decide(observation)
+        keep = residual <= max(self.outlier_factor * float(np.median(residual)), self.stop_tol)
+        if keep.sum() >= 3:
+            ids, current, target = ids[keep], current[keep], target[keep]
         if not np.array_equal(ids, self._law_ids):     # features lost or re-attached:
             self._law = UnifiedLaw(self.unified_config())   # Algorithm 1 starts again
             self._law_ids = ids

@@ -429,15 +429,19 @@ def lab_anywhere(out: str, episodes: int = 40, seed: int = 0, max_steps: int = 8
                  progress: bool = True) -> dict:
     """The unified law (``bearing``) in ``LocalHoming-v0`` in the lab with the env's own
     homes (anywhere in the room) and starts (0.3-1.5 m away), seeds ``seed`` ... ``seed +
-    episodes - 1``, a success being a stop within the env's 0.15 m. Each episode's start
-    and home are also run in the 2-D simulator (:func:`homing_baselines.bearing_sim.simulate`,
-    the lab's landmark points, ideal bearings): the goal is *reachable* when the unified
-    law reaches it there. Writes ``lab_anywhere.json``; returns the counts."""
+    episodes - 1``, a success being a stop within the env's 0.15 m. Each episode is also
+    run in the 2-D simulator (:func:`homing_baselines.bearing_sim.simulate`, the lab's
+    landmark points, ideal bearings): the goal is ``reachable`` when the unified law
+    reaches it there. ``near_circle``: the home lies within 0.1 m of the circle ``C^``
+    (left out of the reachability tables: the snapshot barely fixes the position there);
+    ``goal_landmarks``: poster colours seen in the goal panorama (the laws need three).
+    Writes ``lab_anywhere.json``; returns the counts."""
     import gymnasium as gym
 
     import homing_baselines
     import homing_gym
     from homing_baselines.bearing_sim import simulate
+    from homing_baselines.blobs import detect_blobs
     from homing_gym.scenes.lab import POSTERS
     from homing_train.harness.evaluate import run_episode
     from homing_train.harness.rollout import prepare_policy
@@ -446,6 +450,7 @@ def lab_anywhere(out: str, episodes: int = 40, seed: int = 0, max_steps: int = 8
     env = gym.make("homing_gym/LocalHoming-v0", scene="lab", success_on="stop",
                    max_episode_steps=max_steps, **MEASURED_WITH)
     triangle = np.array([pos for _, pos in POSTERS.values()])
+    centre, radius = circumcircle(triangle)
     controller = homing_baselines.make("bearing")
     prepare_policy(controller, env)
     runs = []
@@ -453,16 +458,22 @@ def lab_anywhere(out: str, episodes: int = 40, seed: int = 0, max_steps: int = 8
                   disable=not progress):
         record = run_episode(env, controller, s)
         start, home = np.array(record.start_pose[:2]), np.array(record.home_pose[:2])
+        goal_view = env.unwrapped.render_panorama(np.array(record.home_pose))
         runs.append({"seed": s, "start": record.start_pose, "home": record.home_pose,
                      "region": str(region(triangle, home)),
                      "reachable": simulate(triangle, start, home).success,
+                     "near_circle": bool(abs(np.hypot(*(home - centre)) - radius) <= 0.1),
+                     "goal_landmarks": len(detect_blobs(goal_view)),
                      "success": record.success, "stopped": record.terminated,
                      "error_cm": round(100 * record.final_distance, 1),
                      "steps": record.steps, "collisions": record.collisions})
     env.close()
     reach = [r for r in runs if r["reachable"]]
+    clear = [r for r in reach if not r["near_circle"] and r["goal_landmarks"] == 3]
     counts = {"episodes": len(runs), "success": sum(r["success"] for r in runs),
-              "reachable": len(reach), "success_reachable": sum(r["success"] for r in reach)}
+              "reachable": len(reach), "success_reachable": sum(r["success"] for r in reach),
+              "reachable_clear": len(clear),
+              "success_reachable_clear": sum(r["success"] for r in clear)}
     os.makedirs(out, exist_ok=True)
     with open(os.path.join(out, "lab_anywhere.json"), "w") as f:
         json.dump({"seed": seed, "max_steps": max_steps, "counts": counts, "runs": runs}, f,
