@@ -481,12 +481,12 @@ def lab_anywhere(out: str, episodes: int = 40, seed: int = 0, max_steps: int = 8
     return counts
 
 
-def longrange(out: str, episodes: int = 10, seed: int = 0, route_length: float = 8.0,
-              progress: bool = True) -> list[dict]:
-    """``bearing-longrange`` on ``LongRangeHoming-v0`` (lab, ``success_on="stop"``: a
-    success when the controller stops within 0.2 m of home) for the seeds ``seed`` ...
-    ``seed + episodes - 1``; each episode is printed and added to ``longrange.json`` as
-    it ends (``homing_from_m``: distance to home at the end of the outbound route)."""
+_LONGRANGE: dict = {}
+
+
+def longrange_episode(seed: int, route_length: float = 8.0) -> dict:
+    """One ``bearing-longrange`` episode of ``LongRangeHoming-v0`` (the env is made once
+    per process): the row of ``longrange.json``."""
     import gymnasium as gym
 
     import homing_baselines
@@ -494,30 +494,53 @@ def longrange(out: str, episodes: int = 10, seed: int = 0, route_length: float =
     from homing_train.harness.evaluate import run_episode
     from homing_train.harness.rollout import prepare_policy
 
-    gym.register_envs(homing_gym)
-    env = gym.make("homing_gym/LongRangeHoming-v0", route_length=route_length,
-                   success_on="stop", **MEASURED_WITH)
+    if _LONGRANGE.get("route_length") != route_length:
+        gym.register_envs(homing_gym)
+        _LONGRANGE.update(route_length=route_length, env=gym.make(
+            "homing_gym/LongRangeHoming-v0", route_length=route_length, success_on="stop",
+            **MEASURED_WITH))
+    env = _LONGRANGE["env"]
+    controller = homing_baselines.make("bearing-longrange")
+    prepare_policy(controller, env)
+    record = run_episode(env, controller, seed)
+    outbound = env.unwrapped.task.outbound_steps
+    end = np.array(record.trajectory[outbound][:2]) - record.home_pose[:2]
+    return {"seed": seed, "success": record.success,
+            "final_cm": round(100 * record.final_distance, 1),
+            "heading_error_deg": round(record.final_heading_error_deg, 1),
+            "homing_from_m": round(float(np.hypot(*end)), 2),
+            "steps": record.steps, "outbound_steps": outbound,
+            "milestones": len(controller.milestones or []),
+            "legs_done": controller.leg, "collisions": record.collisions}
+
+
+def longrange(out: str, episodes: int = 10, seed: int = 0, route_length: float = 8.0,
+              workers: int = 1, progress: bool = True) -> list[dict]:
+    """``bearing-longrange`` on ``LongRangeHoming-v0`` (lab, ``success_on="stop"``: a
+    success when the controller stops within 0.2 m of home) for the seeds ``seed`` ...
+    ``seed + episodes - 1`` over ``workers`` processes; each episode is printed and added
+    to ``longrange.json`` (in seed order) as it ends (``homing_from_m``: distance to home
+    at the end of the outbound route)."""
+    from concurrent.futures import ProcessPoolExecutor
+    from functools import partial
+
+    import homing_baselines
+
     os.makedirs(out, exist_ok=True)
+    params = homing_baselines.make("bearing-longrange").params()
+    seeds = range(seed, seed + episodes)
+    run = partial(longrange_episode, route_length=route_length)
+    pool = ProcessPoolExecutor(workers) if workers > 1 else None
     rows: list[dict] = []
-    for s in tqdm(range(seed, seed + episodes), desc="long-range episodes",
-                  disable=not progress):
-        controller = homing_baselines.make("bearing-longrange")
-        prepare_policy(controller, env)
-        record = run_episode(env, controller, s)
-        outbound = env.unwrapped.task.outbound_steps
-        end = np.array(record.trajectory[outbound][:2]) - record.home_pose[:2]
-        rows.append({"seed": s, "success": record.success,
-                     "final_cm": round(100 * record.final_distance, 1),
-                     "heading_error_deg": round(record.final_heading_error_deg, 1),
-                     "homing_from_m": round(float(np.hypot(*end)), 2),
-                     "steps": record.steps, "outbound_steps": outbound,
-                     "milestones": len(controller.milestones or []),
-                     "legs_done": controller.leg, "collisions": record.collisions})
-        tqdm.write(json.dumps(rows[-1]))
+    for row in tqdm((pool.map if pool else map)(run, seeds), total=episodes,
+                    desc="long-range episodes", disable=not progress):
+        rows.append(row)
+        tqdm.write(json.dumps(row))
         with open(os.path.join(out, "longrange.json"), "w") as f:
-            json.dump({"route_length": route_length, "params": controller.params(),
-                       "episodes": rows}, f, indent=1, default=str)
-    env.close()
+            json.dump({"route_length": route_length, "params": params, "episodes": rows}, f,
+                      indent=1, default=str)
+    if pool:
+        pool.shutdown()
     return rows
 
 
@@ -565,6 +588,7 @@ def main(argv: list[str] | None = None) -> int:
     lr.add_argument("--episodes", type=int, default=10)
     lr.add_argument("--seed", type=int, default=0, help="seed of the first episode")
     lr.add_argument("--route-length", type=float, default=8.0, help="outbound route (m)")
+    lr.add_argument("--workers", type=int, default=1, help="processes")
     lr.add_argument("--no-progress", action="store_true")
     args = parser.parse_args(argv)
     if args.command == "pixel-reachability":
@@ -572,9 +596,11 @@ def main(argv: list[str] | None = None) -> int:
                                        progress=not args.no_progress)
         print(markdown_table(fractions))
     elif args.command == "longrange":
-        rows = longrange(args.out, args.episodes, args.seed, args.route_length,
+        rows = longrange(args.out, args.episodes, args.seed, args.route_length, args.workers,
                          progress=not args.no_progress)
-        print(f"success {sum(r['success'] for r in rows)}/{len(rows)}")
+        within = sum(r["success"] and r["final_cm"] <= 10 for r in rows)
+        print(f"success {sum(r['success'] for r in rows)}/{len(rows)}, "
+              f"within 10 cm {within}/{len(rows)}")
     elif args.command == "lab-anywhere":
         counts = lab_anywhere(args.out, args.episodes, args.seed, args.max_steps,
                               progress=not args.no_progress)
