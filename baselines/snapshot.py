@@ -36,7 +36,15 @@ Choices where the paper is ambiguous (documented in ``docs/hong.md``):
   ``k_psi`` up to 180 deg). ``omega^0`` comes from the §4 weighted formula at ``psi'``.
 * Equal-cost ties of the search in ``omega`` are resolved by the circular mean of the tied
   directions (a plateau arises because intervals are whole samples).
-* ``sigma`` and ``rho`` are floored (``sigma_floor``) so flat windows cannot divide by 0.
+* ``sigma`` is floored (``sigma_floor``) so flat windows cannot divide by 0. ``rho`` is
+  floored at ``rho_floor`` = 0.01, about a tenth of a typical best match (0.03-0.1), in the
+  §4 weight ``|phi - psi| S / rho``: the paper does not say what a near-perfect match
+  weighs; with the old floor (1e-3) one such match, typically a distant wall that barely
+  changes, outweighed all other points 20-fold and turned the weighted direction by up to
+  60 deg (``docs/hong.md``, the 17-target route on the synchro drive).
+* A body that keeps its heading (the synchro drive, as the paper's robot: "the body of the
+  robot does not rotate", §2) searches deviations within ``k_psi_fixed`` of 0 (default 0:
+  the simulated synchro body does not turn at all; the paper's turned by < 3 deg, §3).
 """
 
 from __future__ import annotations
@@ -70,7 +78,8 @@ class HongConfig:
     (statistics of each candidate target window; ``"centre"``: the literal final §3 form,
     the window at ``i + psi``). Paper-open, our choice (sweep in ``docs/hong.md``):
     ``k_high`` 1 (a common scale of every ``rho``; it cancels in every decision),
-    ``k_low`` 0.25, ``min_instant`` 0.02 per sample, ``min_total`` 0.08. ``omega_step``,
+    ``k_low`` 0.25, ``min_instant`` 0.02 per sample, ``min_total`` 0.08, ``rho_floor`` 0.01
+    (the smallest match value used in the §4 weights). ``omega_step``,
     ``coarse_omega_step``: resolution of the fine and of the first (all-direction) search.
     """
 
@@ -89,6 +98,7 @@ class HongConfig:
     k_front: float = 0.0
     k_back: float = 30.0
     sigma_floor: float = 1e-3
+    rho_floor: float = 0.01
     target_stats: str = "candidate"
 
     def __post_init__(self) -> None:
@@ -109,6 +119,7 @@ class HongConfig:
             ("k_front", 0 <= self.k_front <= 90, "in [0, 90] degrees"),
             ("k_back", 0 <= self.k_back <= 90, "in [0, 90] degrees"),
             ("sigma_floor", self.sigma_floor > 0, "> 0"),
+            ("rho_floor", self.rho_floor > 0, "> 0"),
         ]
         bad = [f"{name} must be {rule}, got {getattr(self, name)!r}"
                for name, ok, rule in checks if not ok]
@@ -306,7 +317,7 @@ def hong_homing(current: np.ndarray, target: np.ndarray, config: HongConfig = Ho
     s_range = psi_window(0.0 if psi_prior is None else math.degrees(psi_prior))
     coarse = np.radians(np.arange(-180.0, 180.0, config.coarse_omega_step))
     _, s1, o1, val1, arg1 = _search(runs, theta, s_range, coarse, config)
-    m1, r1 = arg1[:, s1, o1], np.maximum(val1[:, s1, o1], config.sigma_floor)
+    m1, r1 = arg1[:, s1, o1], np.maximum(val1[:, s1, o1], config.rho_floor)
     psi1 = float(s_range[s1] * step)
     # §3 psi_est: weighted mean of the offsets phi_i = psi' + m_i
     wts = cp.sparseness * np.sin(theta) ** 2 / r1
@@ -326,7 +337,7 @@ def hong_homing(current: np.ndarray, target: np.ndarray, config: HongConfig = Ho
     oi = int(tied[np.argmin(np.abs(wrap_angle(omegas[tied] - omega_search)))])
     s_best = int(s_range[si])
     psi = math.radians(s_best * step)
-    m_best, rho_best = arg[:, si, oi], np.maximum(val[:, si, oi], config.sigma_floor)
+    m_best, rho_best = arg[:, si, oi], np.maximum(val[:, si, oi], config.rho_floor)
 
     # 3. §4 homing direction with the three refinements
     offsets = m_best * step
@@ -376,15 +387,17 @@ class SnapshotController(Controller):
     paper's). After a stop it keeps stopping until the goal snapshot changes (a route's
     next target), then restarts the step schedule.
 
-    Deviation: the paper's robot body never rotates (``psi`` < 3 deg); ours turns before
-    each step. The first decision for a target searches every deviation (``k_psi`` = 180,
+    Deviation: the paper's robot body never rotates (``psi`` < 3 deg); the differential
+    robot turns before each step. The first decision for a target searches every deviation (``k_psi`` = 180,
     the paper's largest; ``initial_deviation="compass"``: +-``k_psi_compass`` about the
     whole-signature alignment instead); later ones search ``k_psi_tracked`` about the
     deviation predicted from the previous one plus the rotation the robot itself
     commanded (the ideal unicycle integral of the planned actions: an efference copy, no
-    sensor). ``stop_after``: steps taken before the 40 deg test applies (paper: 1). ``source``: signature from the
-    ``panorama``/``goal`` or the ``omni``/``goal_omni`` observation. The remaining fields
-    are :class:`HongConfig`'s.
+    sensor). A body that keeps its heading (``fixed_heading``; ``None``: true on a synchro
+    drive, whose body never turns, as the paper's) searches deviations within
+    ``k_psi_fixed`` degrees of 0 at every decision. ``stop_after``: steps taken before the
+    40 deg test applies (paper: 1). ``source``: signature from the ``panorama``/``goal`` or
+    the ``omni``/``goal_omni`` observation. The remaining fields are :class:`HongConfig`'s.
     """
 
     source: str = "panorama"
@@ -397,6 +410,8 @@ class SnapshotController(Controller):
     k_psi_tracked: float = 10.0
     initial_deviation: str = "search"
     k_psi_compass: float = 30.0
+    fixed_heading: bool | None = None
+    k_psi_fixed: float = 0.0
     n_points: int = HongConfig.n_points
     min_instant: float = HongConfig.min_instant
     min_total: float = HongConfig.min_total
@@ -407,6 +422,7 @@ class SnapshotController(Controller):
     k_front: float = HongConfig.k_front
     k_back: float = HongConfig.k_back
     target_stats: str = HongConfig.target_stats
+    rho_floor: float = HongConfig.rho_floor
 
     def validate(self) -> None:
         if self.source not in SOURCES:
@@ -423,15 +439,19 @@ class SnapshotController(Controller):
         if not (isinstance(self.stop_after, int) and self.stop_after >= 1):
             raise ValueError(f"snapshot: stop_after must be an integer >= 1 (steps taken "
                              f"before the stop test applies), got {self.stop_after!r}")
+        if self.fixed_heading not in (None, True, False):
+            raise ValueError(f"snapshot: fixed_heading must be None (from the drive), True or "
+                             f"False, got {self.fixed_heading!r}")
         if not (isinstance(self.max_steps, int) and self.max_steps >= 1):
             raise ValueError(f"snapshot: max_steps must be an integer >= 1, got {self.max_steps!r}")
         common = dict(n_points=self.n_points, min_instant=self.min_instant,
                       min_total=self.min_total, k_high=self.k_high, k_low=self.k_low,
                       k_omega=self.k_omega, k_front=self.k_front, k_back=self.k_back,
-                      target_stats=self.target_stats)
+                      target_stats=self.target_stats, rho_floor=self.rho_floor)
         self.config = HongConfig(k_psi=self.k_psi, **common)
         self.tracked_config = HongConfig(k_psi=self.k_psi_tracked, **common)
         self.compass_config = HongConfig(k_psi=self.k_psi_compass, **common)
+        self.fixed_config = HongConfig(k_psi=self.k_psi_fixed, **common)
 
     def on_reset(self) -> None:
         self._goal: np.ndarray | None = None
@@ -440,6 +460,12 @@ class SnapshotController(Controller):
         self._psi: float | None = None
         self._stopped = False
         self.last_estimate: HomingEstimate | None = None
+
+    def body_keeps_heading(self) -> bool:
+        """Whether the body never turns (``fixed_heading``; by default, on a synchro drive)."""
+        if self.fixed_heading is None:
+            return self.motion_spec.drive == "synchro"
+        return bool(self.fixed_heading)
 
     def observation_keys(self) -> tuple[str, str]:
         return ("panorama", "goal") if self.source == "panorama" else ("omni", "goal_omni")
@@ -456,7 +482,10 @@ class SnapshotController(Controller):
             self._steps, self._previous, self._psi, self._stopped = 0, None, None, False
         if self._stopped:
             return None
-        if self._psi is None and self.initial_deviation == "search":
+        if self.body_keeps_heading():
+            est = hong_homing(observation[now_key], goal, self.fixed_config, self.source,
+                              psi_prior=0.0)
+        elif self._psi is None and self.initial_deviation == "search":
             est = hong_homing(observation[now_key], goal, self.config, self.source)
         elif self._psi is None:
             now = signature_of(observation[now_key], self.source, self.config)

@@ -191,14 +191,16 @@ def run_eval(names: list[str], episodes: int = 200) -> dict[str, Any]:
     return res
 
 
-def run_routes(names: list[str], episodes: int = 20,
-               drive: str = "differential") -> dict[str, Any]:
+def run_routes(names: list[str], episodes: int = 20, drive: str = "differential",
+               first_seed: int = 0) -> dict[str, Any]:
     """RouteFollowing-v0, ``success_on="stop"``: share of routes with all 17 targets
     reached (every stop within the 0.1 m radius) and mean per-target error; with
     ``drive="synchro"`` on Hong's robot, which translates without turning (keys end in
     ``/synchro``): it is put at the route's heading (``start_jitter`` 5 cm, 0 rad), since
     a body that never turns could never correct a start heading error, and the paper's
-    robot took its snapshots and ran with one heading."""
+    robot took its snapshots and ran with one heading. Routes use the env seeds
+    ``first_seed``, ``first_seed + 1``, ...; keys of a ``first_seed`` other than 0 end
+    in ``/seeds=FIRST-LAST``."""
     res = {}
     for name in names:
         for light in (0.0, 0.5):
@@ -212,7 +214,8 @@ def run_routes(names: list[str], episodes: int = 20,
             policy = policy_spec(name).build()
             prepare_policy(policy, env)
             all_ok, errors, n_done, last_ok = [], [], [], []
-            for seed in tqdm(range(episodes), desc=f"{name} route light={light}"):
+            seeds = range(first_seed, first_seed + episodes)
+            for seed in tqdm(seeds, desc=f"{name} route light={light}"):
                 info = rollout(env, policy, seed).info
                 errs = list(info["target_errors"])      # read by the harness only
                 errors.extend(errs)
@@ -220,7 +223,10 @@ def run_routes(names: list[str], episodes: int = 20,
                 all_ok.append(len(errs) == 17 and max(errs) < radius)
                 last_ok.append(bool(info["is_success"]))
             env.close()
-            res[f"{name}/lighting={light}" + ("/synchro" if drive == "synchro" else "")] = {
+            key = f"{name}/lighting={light}" + ("/synchro" if drive == "synchro" else "")
+            if first_seed:
+                key += f"/seeds={seeds[0]}-{seeds[-1]}"
+            res[key] = {
                 "all_17_within_radius": float(np.mean(all_ok)),
                 "episode_success": float(np.mean(last_ok)),
                 "mean_target_error_m": float(np.mean(errors)) if errors else None,
@@ -282,6 +288,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--routes", type=int, default=20)
     parser.add_argument("--drive", choices=["differential", "synchro"], default="differential",
                         help="the robot of the route runs (synchro: Hong's, never turns)")
+    parser.add_argument("--route-seed", type=int, default=0,
+                        help="the first env seed of the routes (default 0)")
     args = parser.parse_args(argv)
     gym.register_envs(homing_gym)
     os.makedirs(args.out, exist_ok=True)
@@ -298,7 +306,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"methods: {names}")
     steps = {"signature": lambda: plot_signature(args.out), "sweep": lambda: run_sweep(), "field": lambda: run_fields(args.out, names),
              "eval": lambda: run_eval(names, args.episodes),
-             "route": lambda: run_routes(names, args.routes, args.drive)}
+             "route": lambda: run_routes(names, args.routes, args.drive, args.route_seed)}
     for key in args.only:
         value = steps[key]()
         if key in PER_METHOD and isinstance(results.get(key), dict):
