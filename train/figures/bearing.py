@@ -430,9 +430,10 @@ def lab_anywhere(out: str, episodes: int = 40, seed: int = 0, max_steps: int = 8
     """The unified law (``bearing``) in ``LocalHoming-v0`` in the lab with the env's own
     homes (anywhere in the room) and starts (0.3-1.5 m away), seeds ``seed`` ... ``seed +
     episodes - 1``, a success being a stop within the env's 0.15 m. Each episode is also
-    run in the 2-D simulator (:func:`homing_baselines.bearing_sim.simulate`, the lab's
-    landmark points, ideal bearings): the goal is ``reachable`` when the unified law
-    reaches it there. ``near_circle``: the home lies within 0.1 m of the circle ``C^``
+    run in the 2-D simulator (:func:`simulated`: the lab's landmark points, ideal
+    bearings, no walls): the goal is ``reachable`` when the unified law reaches it there,
+    and its path is ``path_clear`` when it keeps off the room's walls and furniture.
+    ``near_circle``: the home lies within 0.1 m of the circle ``C^``
     (left out of the reachability tables: the snapshot barely fixes the position there);
     ``goal_landmarks``: poster colours seen in the goal panorama (the laws need three).
     Writes ``lab_anywhere.json``; returns the counts."""
@@ -440,7 +441,6 @@ def lab_anywhere(out: str, episodes: int = 40, seed: int = 0, max_steps: int = 8
 
     import homing_baselines
     import homing_gym
-    from homing_baselines.bearing_sim import simulate
     from homing_baselines.blobs import detect_blobs
     from homing_gym.scenes.lab import POSTERS
     from homing_train.harness.evaluate import run_episode
@@ -451,6 +451,8 @@ def lab_anywhere(out: str, episodes: int = 40, seed: int = 0, max_steps: int = 8
                    max_episode_steps=max_steps, **MEASURED_WITH)
     triangle = np.array([pos for _, pos in POSTERS.values()])
     centre, radius = circumcircle(triangle)
+    scene = env.unwrapped.scene
+    body = env.unwrapped.robot_config.body_radius
     controller = homing_baselines.make("bearing")
     prepare_policy(controller, env)
     runs: list[dict] = []
@@ -461,7 +463,7 @@ def lab_anywhere(out: str, episodes: int = 40, seed: int = 0, max_steps: int = 8
         goal_view = env.unwrapped.render_panorama(np.array(record.home_pose))
         runs.append({"seed": s, "start": record.start_pose, "home": record.home_pose,
                      "region": str(region(triangle, home)),
-                     "reachable": simulate(triangle, start, home).success,
+                     **simulated(scene, triangle, start, home, body),
                      "near_circle": bool(abs(np.hypot(*(home - centre)) - radius) <= 0.1),
                      "goal_landmarks": len(detect_blobs(goal_view)),
                      "success": record.success, "stopped": record.terminated,
@@ -475,11 +477,30 @@ def lab_anywhere(out: str, episodes: int = 40, seed: int = 0, max_steps: int = 8
     return anywhere_counts(runs)
 
 
+def simulated(scene, landmarks: np.ndarray, start, home, body: float) -> dict[str, bool]:
+    """The unified law from ``start`` to ``home`` in the 2-D simulator: ``reachable`` (it
+    gets there) and ``path_clear`` (its path keeps ``body`` metres from the walls and
+    furniture of ``scene``; the landmark columns, which the controllers go round, are
+    left out)."""
+    import dataclasses
+
+    from homing_baselines.bearing_sim import simulate
+    from homing_gym.scenes.base import clearances
+
+    run = simulate(landmarks, start, home)
+    room = dataclasses.replace(scene, landmarks=tuple(
+        lm for lm in scene.landmarks if not lm.name.startswith("poster")))
+    return {"reachable": run.success,
+            "path_clear": bool(clearances(room, run.trajectory).min() >= body)}
+
+
 def anywhere_counts(runs: list[dict]) -> dict[str, int]:
     """Episodes and successes of :func:`lab_anywhere`: all; those the 2-D simulator
-    reaches; those of them off the circle's band whose goal sees the three landmarks."""
+    reaches; those of them whose simulated path stays clear of the walls and furniture,
+    off the circle's band, with the three landmarks seen from the goal."""
     reach = [r for r in runs if r["reachable"]]
-    clear = [r for r in reach if not r["near_circle"] and r["goal_landmarks"] == 3]
+    clear = [r for r in reach if r["path_clear"] and not r["near_circle"]
+             and r["goal_landmarks"] == 3]
     return {"episodes": len(runs), "success": sum(r["success"] for r in runs),
             "reachable": len(reach), "success_reachable": sum(r["success"] for r in reach),
             "reachable_clear": len(clear),
