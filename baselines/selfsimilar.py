@@ -588,9 +588,10 @@ class SelfSimilarController(Controller):
         self._normal = wrap_angle(normal)
 
     def _arrive(self, goal: int) -> Move | None:
-        """Standing in front of the target: annotate the edge driven (§4.1), relocalise
-        at an anchor of the map or record this standing pose as one, then finish (the
-        goal) or scan / plan the next hop."""
+        """Standing in front of the target: annotate the edge driven (§4.1), take the
+        pose of the landmark's anchor (relocalising if not localised; else it clears the
+        drift of dead reckoning) or record this standing pose as its anchor, then finish
+        (the goal) or scan / plan the next hop."""
         landmark = self._target
         if self._came_from is not None:
             self._update_map("traversed", self._came_from, landmark, self._travelled)
@@ -601,6 +602,8 @@ class SelfSimilarController(Controller):
         relocalised = not self._localised and landmark in self._map.standing
         if relocalised:
             self._relocalise(landmark)
+        elif self._localised and landmark in self._map.standing:
+            self._pose = self._map.standing[landmark].copy()   # the drift goes
         else:
             self._update_map("stood", landmark, self._pose.copy())
         if landmark == goal:
