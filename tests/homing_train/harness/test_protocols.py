@@ -147,6 +147,21 @@ def test_matrix_files_name_every_cell_with_its_command(tmp_path):
     assert open(written["png"], "rb").read(4) == b"\x89PNG"
 
 
+def test_merged_cells_replace_the_same_cell_and_keep_the_order():
+    from homing_train.harness.matrix import merged_cells
+
+    def cell(protocol, method, rate):
+        return Cell(protocol, 1, method, "", {"success_rate": rate}, {})
+
+    old = [cell("yukim", "warping", 0.1), cell("yukim", "distance", 0.2),
+           cell("hong1991", "warping", 0.3)]
+    new = [cell("yukim", "distance", 0.9), cell("bekris-lab", "bearing", 0.5)]
+    got = merged_cells(old, new)
+    assert [(c.protocol, c.method, c.summary["success_rate"]) for c in got] == [
+        ("yukim", "warping", 0.1), ("yukim", "distance", 0.9), ("hong1991", "warping", 0.3),
+        ("bekris-lab", "bearing", 0.5)]
+
+
 def test_hong_starts_are_one_foot_from_home_with_the_homes_heading():
     from homing_train.harness.protocols import FOOT, common_heading_starts
 
