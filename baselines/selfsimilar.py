@@ -95,8 +95,10 @@ Choices where the paper is silent (also in ``docs/selfsimilar.md``):
 * *Relocalisation across episodes* (``memory="world"``; the paper's robot is switched on
   once): the robot's pose at a landmark's standing place is about the same every time
   (within the servoing tolerance, ``ARRIVE_DISTANCE`` and ``ARRIVE_ANGLE``), so the pose
-  of its first arrival there is kept as the landmark's anchor and taken as the pose on a
-  later arrival when not localised; the full scan that follows recalibrates the heading
+  of its first arrival there is kept as the landmark's anchor and taken as the pose on
+  every later arrival (with either memory: within an episode dead reckoning drifts by
+  metres, since the wheels slip against walls and turns made in contact do not happen);
+  when the robot was not localised, the full scan that follows recalibrates the heading
   (§4.1). Until then the robot plans nothing over the graph (its angles are in the map
   frame): it goes from landmark to landmark as from nowhere, preferring anchors, and
   dead-reckons only to landmarks seen in this episode. A world is named by its scene: the
