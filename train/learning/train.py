@@ -42,11 +42,10 @@ from homing_gym.cli import command_parser
 from homing_train.extras import MissingExtraError, require_extra
 from homing_train.learning import EXTRACTORS
 from homing_train.learning.imitation import dagger
+from homing_train.learning.ppo_settings import PPO_KEYS, check_ppo, ppo_arguments
 from homing_train.learning.pretrain import pretrain
 
 HYPERPARAMS = Path(str(resources.files("homing_train.learning") / "hyperparams" / "ppo.yml"))
-PPO_KEYS = ("n_steps", "batch_size", "n_epochs", "learning_rate", "gamma", "gae_lambda",
-            "clip_range", "ent_coef", "vf_coef", "max_grad_norm")
 EVAL_SEED_OFFSET = 1_000_000
 IMITATION_SEED_OFFSET = 2_000_000
 PRETRAIN_SEED_OFFSET = 3_000_000
@@ -108,9 +107,7 @@ class TrainConfig:
         if not isinstance(self.eval_deterministic, bool):
             raise ValueError(f"eval_deterministic must be true or false, got "
                              f"{self.eval_deterministic!r}")
-        unknown = sorted(set(self.ppo) - set(PPO_KEYS))
-        if unknown:
-            raise ValueError(f"unknown PPO hyperparameters {unknown}; allowed: {list(PPO_KEYS)}")
+        check_ppo(self.ppo, self.n_envs)
 
 
 def load_hyperparams(env_id: str, path: Path = HYPERPARAMS) -> dict[str, Any]:
@@ -364,9 +361,14 @@ def new_model(config: TrainConfig, env, **kwargs):
 
     extractor_kwargs = ({"features_dim": config.features_dim}
                         if config.extractor == "panorama" else {})
+    if config.ppo.get("use_sde") and not isinstance(env.action_space, gym.spaces.Box):
+        raise ValueError(f"use_sde needs continuous actions (action_type='continuous'); "
+                         f"this env's action space is {env.action_space}")
+    ppo = ppo_arguments(config.ppo)
+    policy_kwargs = {**policy_kwargs_for(config.extractor, **extractor_kwargs),
+                     **ppo.pop("policy_kwargs")}
     return PPO("MultiInputPolicy", env, seed=config.seed, device=config.device, verbose=0,
-               policy_kwargs=policy_kwargs_for(config.extractor, **extractor_kwargs),
-               **config.ppo, **kwargs)
+               policy_kwargs=policy_kwargs, **ppo, **kwargs)
 
 
 def train(config: TrainConfig, out: Path, resume: bool = False,
