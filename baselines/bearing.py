@@ -32,10 +32,22 @@ Choices where the paper is open (also in ``docs/bearing.md``):
   simulator (20 cm and 5 cm at 1 cm per step) at ``min_step`` per decision (10 and 3
   decisions): on the NLP arc, where criterion 4 is judged, ``|M|`` is small and the
   steps are short. Shorter spans read pixel noise as a trend.
-* **Fewer than three landmarks** seen in both snapshots (occlusion by another column,
-  or one outside the view): the laws need three, so the robot continues along its last
-  direction by ``min_step`` (or turns by 90 degrees on the spot if it has none yet) and
-  looks again.
+* **A landmark hidden behind another column** (:meth:`BearingController.bearings_with_occluded`):
+  the paper's tracker "was able to recapture the landmark as soon as it reappeared"
+  (§5) but the paper does not say what the robot does meanwhile. A landmark missing now
+  that was within ``occlusion_gap`` radians of a landmark seen now, at the last decision
+  that saw all of them, lies behind that column and takes its bearing (error below the
+  column's half-width). In the goal snapshot a single missing landmark is put behind the
+  widest (nearest) column seen (:func:`goal_bearings`): only a nearer column can hide it.
+* **Going round a near column** (:meth:`BearingController.around_columns`): the laws
+  treat landmarks as points, and the straight way to a goal can run through a column
+  (the paper's panels were out of the robot's way; §5: the law resumes "as soon as the
+  interrupting process completed"). A column whose blob spans at least ``near_width``
+  radians and more than in the goal snapshot, with the move heading towards it, is
+  stepped round perpendicular to its bearing, on the move's side.
+* **Fewer than three landmarks** even then (one out of sight for another reason): the
+  laws need three, so the robot continues along its last direction by ``min_step`` (or
+  turns by 90 degrees on the spot if it has none yet) and looks again.
 
 The controller reads ``panorama`` and ``goal`` only.
 """
@@ -108,7 +120,10 @@ class BearingLawController(Controller):
 @dataclass
 class BearingController(BearingLawController):
     """Bearing-only homing from coloured blobs (module docstring). Parameters: ``colors``
-    (names in :data:`PALETTE`, at least 3), ``min_area`` (pixels of a blob) and those of
+    (names in :data:`PALETTE`, at least 3), ``min_area`` (pixels of a blob),
+    ``occlusion_gap`` (radians: how near a column a landmark must have been to be taken
+    as hidden behind it), ``near_width`` (radians: the blob width from which a column is
+    near, 0.45 rad = about 0.45 m for the lab's 0.1 m columns) and those of
     :class:`BearingLawController`. The law is the class's ``law``: ``unified`` here."""
 
     colors: tuple[str, ...] = ("red", "green", "blue")
@@ -129,6 +144,10 @@ class BearingController(BearingLawController):
                              f"{sorted(PALETTE)}, got {self.colors!r}")
         if not (isinstance(self.min_area, (int, np.integer)) and self.min_area >= 1):
             raise ValueError(f"min_area must be an integer >= 1 pixels, got {self.min_area!r}")
+        for name in ("occlusion_gap", "near_width"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and 0 < value < math.pi):
+                raise ValueError(f"{name} must be in (0, pi) radians, got {value!r}")
 
     def on_reset(self) -> None:
         self._unified = UnifiedLaw(self.unified_config())
@@ -195,6 +214,7 @@ class BearingController(BearingLawController):
                 return Move(float(wrap_angle(blob.bearing + side * math.pi / 2)), move.distance)
         self._detour = {}
         return move
+
 
 def goal_bearings(goal: dict[str, Blob], colors: tuple[str, ...]) -> dict[str, float]:
     """Bearings (radians) of the goal snapshot's landmarks. When exactly one colour is

@@ -151,6 +151,8 @@ def test_bearing_controllers_run_in_the_harness_from_the_observation_only():
     ({"stop_tol": 0.0}, "stop_tol"),
     ({"gain": float("nan")}, "gain"),
     ({"min_area": 0}, "min_area"),
+    ({"occlusion_gap": 0.0}, "occlusion_gap"),
+    ({"near_width": 4.0}, "near_width"),
 ])
 def test_bad_controller_parameters_raise(params, match):
     for name in ("bearing", "bearing-basic", "bearing-complementary"):
