@@ -93,12 +93,11 @@ def color_mask(panorama: np.ndarray, color: BlobColor) -> np.ndarray:
     return ok.astype(np.uint8) * 255
 
 
-def largest_blob(mask: np.ndarray,
-                 min_area: int = 4) -> tuple[float, float, int, int] | None:
+def largest_blob(mask: np.ndarray, min_area: int = 4) -> tuple[float, float, int, int] | None:
     """Centroid ``(x, y)`` (continuous pixel coordinates, ``x`` in ``[0, W)``), area and
-    width (columns) of the largest 8-connected component of a panorama mask, seam-aware (see the module
-    docstring); ``None`` if there is none of ``min_area`` pixels or the mask fills every
-    column."""
+    width (columns) of the largest 8-connected component of a panorama mask, seam-aware
+    (see the module docstring); ``None`` if there is none of ``min_area`` pixels or the
+    mask fills every column."""
     W = mask.shape[1]
     empty = np.flatnonzero(~mask.any(axis=0))
     if empty.size == 0:
