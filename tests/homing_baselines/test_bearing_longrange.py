@@ -82,6 +82,9 @@ def test_arrival_when_the_residual_is_small_or_stalls_near_zero():
     assert not any(controller._arrived(np.full(40, 0.039 * 0.94 ** k)) for k in range(11))
     controller.reset()
     assert not any(controller._arrived(np.full(40, 0.05)) for _ in range(30))   # too far
+    controller.reset()
+    controller.milestones, controller.leg = [5, 0], 1          # home: no stall arrival
+    assert not any(controller._arrived(np.full(40, 0.03)) for _ in range(30))
 
 
 @pytest.mark.slow
