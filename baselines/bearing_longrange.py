@@ -29,12 +29,13 @@ at least ``inlier_fraction`` of the leg's live features lie within ``stop_tol`` 
 with ``aligned=True`` after rotating by ``phi``), made robust to the KLT tracks that drift
 onto another corner over a long leg (one would stop the plain test from ever holding).
 At an MP other than home it has also arrived when the median residual is within
-``stall_tol`` and has not improved by 5% for ``stall_decisions`` decisions: §3 names "inaccuracies in the feature
-tracking process" and "the non-perfect achievement of P" as the errors of ``phi``, and
-drifted tracks and nearby corners (the desk, 0.3 m away, moves by 0.1 rad in 3 cm) can
-hold the median above ``stop_tol`` even 1-5 cm from the MP, where the robot then
-dithered until the step limit (seed 206: 1400 steps within 5 cm of one MP). Home keeps
-the strict test: stalls there ended 11-12 cm away. It then predicts where every feature of the MP's memory frame lies now (shifted by ``phi``)
+``stall_tol`` and has not improved by 5% for ``stall_decisions`` decisions: §3 names
+"inaccuracies in the feature tracking process" and "the non-perfect achievement of P"
+as the errors of ``phi``, and drifted tracks and nearby corners (the desk, 0.3 m away,
+moves by 0.1 rad in 3 cm) can hold the median above ``stop_tol`` even 1-5 cm from the
+MP, where the robot then dithered until the step limit (seed 206: 1400 steps within
+5 cm of one MP). Home keeps the strict test: stalls there ended 11-12 cm away. It then
+predicts where every feature of the MP's memory frame lies now (shifted by ``phi``)
 and re-attaches them by LK from the stored image, starting at the prediction
 (:meth:`homing_baselines.klt.CornerTracker.register`: the paper's "feature selection ... in
 small windows centred at the predicted locations"), and starts the next leg. At home it
@@ -168,7 +169,8 @@ class LongRangeBearingController(BearingLawController):
         if not 0 < self.inlier_fraction <= 1:
             raise ValueError(f"inlier_fraction must be in (0, 1], got {self.inlier_fraction!r}")
         if not (math.isfinite(self.outlier_factor) and self.outlier_factor >= 1):
-            raise ValueError(f"outlier_factor must be finite and >= 1, got {self.outlier_factor!r}")
+            raise ValueError(f"outlier_factor must be finite and >= 1, got "
+                             f"{self.outlier_factor!r}")
         if not (math.isfinite(self.stall_tol) and self.stall_tol >= 0):
             raise ValueError(f"stall_tol must be finite and >= 0 radians, got {self.stall_tol!r}")
         if not (isinstance(self.stall_decisions, (int, np.integer)) and self.stall_decisions >= 1):
