@@ -27,15 +27,8 @@ place under another heading, so every bearing differs by one constant,
 at least ``inlier_fraction`` of the leg's live features lie within ``stop_tol`` of
 ``phi``: Algorithm 1's "snapshots similar" (:func:`homing_baselines.bearing_laws.snapshots_similar`
 with ``aligned=True`` after rotating by ``phi``), made robust to the KLT tracks that drift
-onto another corner over a long leg (one would stop the plain test from ever holding).
-At an MP other than home it has also arrived when the median residual is within
-``stall_tol`` and has not improved by 5% for ``stall_decisions`` decisions: §3 names
-"inaccuracies in the feature tracking process" and "the non-perfect achievement of P"
-as the errors of ``phi``, and drifted tracks and nearby corners (the desk, 0.3 m away,
-moves by 0.1 rad in 3 cm) can hold the median above ``stop_tol`` even 1-5 cm from the
-MP, where the robot then dithered until the step limit (seed 206: 1400 steps within
-5 cm of one MP). Home keeps the strict test: stalls there ended 11-12 cm away. It then
-predicts where every feature of the MP's memory frame lies now (shifted by ``phi``)
+onto another corner over a long leg (one would stop the plain test from ever holding). It
+then predicts where every feature of the MP's memory frame lies now (shifted by ``phi``)
 and re-attaches them by LK from the stored image, starting at the prediction
 (:meth:`homing_baselines.klt.CornerTracker.register`: the paper's "feature selection ... in
 small windows centred at the predicted locations"), and starts the next leg. At home it
@@ -140,8 +133,7 @@ class LongRangeBearingController(BearingLawController):
     consecutive milestones share, 3 to ``klt.max_features``), ``inlier_fraction`` (of a
     leg's live features that must agree with ``phi`` to arrive), ``outlier_factor``
     (features whose offset residual exceeds this many times the median residual are left
-    out of the law), ``stall_tol`` and ``stall_decisions`` (the arrival test's stall,
-    :meth:`_arrived`), ``klt``
+    out of the law), ``klt``
     (:class:`~homing_baselines.klt.KLTConfig`) and those of
     :class:`~homing_baselines.bearing.BearingLawController` (``stop_tol``: the arrival tolerance
     on each feature's offset from ``phi``, radians)."""
@@ -149,8 +141,6 @@ class LongRangeBearingController(BearingLawController):
     min_shared: int = 80
     inlier_fraction: float = 0.5
     outlier_factor: float = 3.0
-    stall_tol: float = 0.04
-    stall_decisions: int = 10
     stop_tol: float = 0.02
     klt: KLTConfig = field(default_factory=KLTConfig)
 
@@ -171,11 +161,6 @@ class LongRangeBearingController(BearingLawController):
         if not (math.isfinite(self.outlier_factor) and self.outlier_factor >= 1):
             raise ValueError(f"outlier_factor must be finite and >= 1, got "
                              f"{self.outlier_factor!r}")
-        if not (math.isfinite(self.stall_tol) and self.stall_tol >= 0):
-            raise ValueError(f"stall_tol must be finite and >= 0 radians, got {self.stall_tol!r}")
-        if not (isinstance(self.stall_decisions, (int, np.integer)) and self.stall_decisions >= 1):
-            raise ValueError(f"stall_decisions must be an integer >= 1, got "
-                             f"{self.stall_decisions!r}")
 
     def observation_keys(self) -> tuple[str, ...]:
         return ("panorama", "phase")
@@ -192,7 +177,6 @@ class LongRangeBearingController(BearingLawController):
         self._law = UnifiedLaw(self.unified_config())
         self._law_ids = np.zeros(0, dtype=np.int64)
         self._home = False
-        self._best, self._stalled = math.inf, 0
 
     def predict(self, observation, state=None, episode_start=None, deterministic=True):
         """Track every frame (the base class decides only between moves), then act: stop
@@ -220,24 +204,6 @@ class LongRangeBearingController(BearingLawController):
         self.leg = leg
         self.leg_ids = np.intersect1d(self.memory[self.milestones[leg]].ids,
                                       self.memory[origin].ids)
-        self._best, self._stalled = math.inf, 0     # the arrival test's stall count
-
-    def _arrived(self, residual: np.ndarray) -> bool:
-        """§3's arrival, "snapshots similar": ``inlier_fraction`` of the leg's features
-        within ``stop_tol`` of ``phi``; or, at an MP other than home, the median residual
-        within ``stall_tol`` and no 5% better than its best for ``stall_decisions``
-        decisions (as near as the tracks allow; home keeps the strict test, where the
-        accuracy is the result). ``residual``: each feature's ``|A_P - A_P' - phi|``
-        (radians)."""
-        level = float(np.median(residual))
-        if level < 0.95 * self._best:
-            self._best, self._stalled = level, 0
-        else:
-            self._stalled += 1
-        stalled = level <= self.stall_tol and self._stalled >= self.stall_decisions
-        home = self.milestones is not None and self.leg == len(self.milestones) - 1
-        return bool(np.mean(residual <= self.stop_tol) >= self.inlier_fraction
-                    or (stalled and not home))
 
     def _bearings(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Ids, current and milestone bearings (radians) of the leg's live features."""
@@ -266,7 +232,7 @@ class LongRangeBearingController(BearingLawController):
         offsets = wrap_angle(target - current)
         self.phi = median_offset(offsets)
         residual = np.abs(wrap_angle(offsets - self.phi))
-        if self._arrived(residual):
+        if np.mean(residual <= self.stop_tol) >= self.inlier_fraction:
             if self.leg == len(self.milestones) - 1:   # home: turn to its heading, stop
                 self._home = True
                 return Move(float(wrap_angle(-self.phi)), 0.0)
