@@ -88,17 +88,25 @@ def localisation_experiment(daily_changes: float, spacing: float, headings: int,
     return rows
 
 
-def summarise_localisation(rows: list[dict]) -> dict:
+def _errors_summary(rows: list[dict]) -> dict:
+    """Error statistics of ``rows``; the share counts unlocalised poses as failures."""
     ok = [r for r in rows if r["ok"]]
     err = np.array([r["error_cm"] for r in ok])
     head = np.array([r["heading_error_deg"] for r in ok])
-    loc_s = float(np.mean([r["localise_s"] for r in rows]))
-    all_s = float(np.mean([r["localise_s"] + r["render_s"] for r in rows]))
     return {"poses": len(rows), "localised": len(ok),
             "error_cm_median": float(np.median(err)), "error_cm_p90": float(np.percentile(err, 90)),
             "heading_deg_median": float(np.median(head)),
             "heading_deg_p90": float(np.percentile(head, 90)),
-            "share_within_10cm_and_2deg_of_all": float(np.sum((err < 10) & (head < 2)) / len(rows)),
+            "share_within_10cm_and_2deg_of_all": float(np.sum((err < 10) & (head < 2)) / len(rows))}
+
+
+def summarise_localisation(rows: list[dict]) -> dict:
+    """:func:`_errors_summary` of all rows and of each work location's, and the speed."""
+    loc_s = float(np.mean([r["localise_s"] for r in rows]))
+    all_s = float(np.mean([r["localise_s"] + r["render_s"] for r in rows]))
+    by_location = {name: _errors_summary([r for r in rows if r["location"] == name])
+                   for name in LOCATIONS if any(r["location"] == name for r in rows)}
+    return {**_errors_summary(rows), "by_location": by_location,
             "localisations_per_s": 1 / loc_s, "with_rendering_per_s": 1 / all_s}
 
 
