@@ -35,12 +35,11 @@ of seeds, ``RUNS/nav_<planning>_<clean|changed>_s<first seed>.json``, into
 results table: success with its 95 % bootstrap interval (:func:`homing_train.harness.metrics.bootstrap_ci`),
 median path length and shortest path of the successes, steps, collisions.
 
-``memory``: the map kept across episodes (``memory="world"``) against a map per episode.
-Reads ``RUNS/seq_<planning>_<clean|changed>.json``, each one ``homing-eval`` run of
-``--param memory=world`` over a sequence of seeds with ``--workers 1`` (one controller,
-so one map, for the whole sequence), copies them under ``--out`` and prints them beside
-the per-episode runs (``nav_<planning>_<condition>.json``, merged by ``nav``, from
-``RUNS`` or else from ``--out``): success, successes per block of 10 episodes of the
+``memory``: the map kept across episodes against a map per episode. Reads
+``RUNS/memory_<planning>_<clean|changed>_<world|episode>.json``, each one ``homing-eval``
+run of ``--param memory=world`` or ``episode`` over a sequence of seeds with
+``--workers 1`` (one controller, so one map, for the whole sequence), copies them under
+``--out`` and prints a table: success, successes per block of 10 episodes of the
 sequence, SPL, median path length over the shortest path of the successes, steps.
 """
 
@@ -314,6 +313,7 @@ def measure_layout() -> dict:
 
 
 PLANNINGS, CONDITIONS = ("deterministic", "probabilistic"), ("clean", "changed")
+MEMORIES = ("episode", "world")
 
 
 def merge_nav_runs(runs: str, out: str) -> dict:
@@ -360,24 +360,19 @@ def nav_table(merged: dict) -> str:
 
 
 def memory_results(runs: str, out: str) -> dict:
-    """``{(planning, condition, memory): EvalResult}``: the sequences (``memory`` "world")
-    in ``runs``, saved under ``out``, and the per-episode runs ("episode") merged from
-    ``runs``, or those under ``out``."""
+    """``{(planning, condition, memory): EvalResult}`` of the runs
+    ``runs/memory_<planning>_<condition>_<memory>.json``, each saved under ``out``."""
     from homing_train.harness.evaluate import EvalResult
 
     results = {}
-    per_episode = merge_nav_runs(runs, out) or {
-        (p, c): EvalResult.load(path) for p in PLANNINGS for c in CONDITIONS
-        for path in [os.path.join(out, f"nav_{p}_{c}.json")] if os.path.exists(path)}
-    for (planning, condition), result in per_episode.items():
-        results[(planning, condition, "episode")] = result
     for planning in PLANNINGS:
         for condition in CONDITIONS:
-            path = os.path.join(runs, f"seq_{planning}_{condition}.json")
-            if os.path.exists(path):
-                result = EvalResult.load(path)
-                result.save(os.path.join(out, f"seq_{planning}_{condition}.json"))
-                results[(planning, condition, "world")] = result
+            for memory in MEMORIES:
+                name = f"memory_{planning}_{condition}_{memory}.json"
+                if os.path.exists(os.path.join(runs, name)):
+                    result = EvalResult.load(os.path.join(runs, name))
+                    result.save(os.path.join(out, name))
+                    results[(planning, condition, memory)] = result
     return results
 
 
@@ -388,7 +383,7 @@ def memory_table(results: dict, block: int = 10) -> str:
              f"successes per {block} episodes | SPL | path / shortest, median of successes "
              "| steps, median |", "|---|---|---|---:|---:|---|---:|---:|---:|"]
     for key in sorted(results, key=lambda k: (PLANNINGS.index(k[0]), CONDITIONS.index(k[1]),
-                                              k[2] == "world")):
+                                              MEMORIES.index(k[2]))):
         planning, condition, memory = key
         r = results[key]
         episodes = sorted(r.episodes, key=lambda e: e.seed)
@@ -422,8 +417,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"{args.what} needs --runs FOLDER")
     if args.what == "memory":
         results = memory_results(args.runs, args.out)
-        if not any(k[2] == "world" for k in results):
-            parser.error(f"no seq_<planning>_<condition>.json in {args.runs!r}")
+        if not results:
+            parser.error(f"no memory_<planning>_<condition>_<memory>.json in {args.runs!r}")
         print(memory_table(results))
         return 0
     if args.what == "nav":
