@@ -415,17 +415,14 @@ def main(argv: list[str] | None = None) -> int:
     os.makedirs(args.out, exist_ok=True)
     if args.what in ("nav", "memory") and not args.runs:
         parser.error(f"{args.what} needs --runs FOLDER")
-    if args.what == "memory":
-        results = memory_results(args.runs, args.out)
+    runs = {"memory": (memory_results, memory_table, "memory_<planning>_<condition>_<memory>"),
+            "nav": (merge_nav_runs, nav_table, "nav_<planning>_<condition>_s<seed>")}
+    if args.what in runs:
+        collect, table, pattern = runs[args.what]
+        results = collect(args.runs, args.out)
         if not results:
-            parser.error(f"no memory_<planning>_<condition>_<memory>.json in {args.runs!r}")
-        print(memory_table(results))
-        return 0
-    if args.what == "nav":
-        merged = merge_nav_runs(args.runs, args.out)
-        if not merged:
-            parser.error(f"no nav_<planning>_<condition>_s<seed>.json in {args.runs!r}")
-        print(nav_table(merged))
+            parser.error(f"no {pattern}.json in {args.runs!r}")
+        print(table(results))
         return 0
     if args.what == "layout":
         result = measure_layout()
