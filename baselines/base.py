@@ -86,6 +86,11 @@ class Controller(ABC):
     def on_reset(self) -> None:
         """Clear per-episode memory (called by :meth:`reset`)."""
 
+    def keeps_memory_across_episodes(self) -> bool:
+        """Whether an episode depends on the episodes before it (a map kept per world):
+        the harness then runs all episodes in order, in one process."""
+        return False
+
     def observation_keys(self) -> tuple[str, ...]:
         """The env observation keys this controller reads (the harness asks the env for
         them when the user did not choose ``obs_keys``)."""

@@ -240,6 +240,9 @@ class SelfSimilarController(Controller):
     def observation_keys(self) -> tuple[str, ...]:
         return ("view", "goal_id", "odometry")
 
+    def keeps_memory_across_episodes(self) -> bool:
+        return self.memory == "world"
+
     def check_env(self, env) -> None:
         """Note which world the episodes are in: the env's scene, by name (what an
         operator tells the robot, "you are in building X"; nothing of its layout, its

@@ -296,7 +296,9 @@ def run_episodes(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
     ``workers`` processes (``backend="local"``: spawned processes, 1 = in this process;
     ``"ray"``: Ray actors, on the cluster at ``address`` or a local Ray). Records come
     back in task order, the same on either backend; ``on_record`` sees each one as soon
-    as it is finished (in finishing order)."""
+    as it is finished (in finishing order). A policy whose episodes depend on the ones
+    before (:attr:`PolicySpec.sequential`) runs them in order in this process, whatever
+    ``workers`` and ``backend`` say, so results do not depend on how episodes are split."""
     for task in tasks:
         if not 1 <= len(task) <= 3:
             raise ValueError(f"a task is (seed, start, home), got {task!r}")
@@ -304,6 +306,8 @@ def run_episodes(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
         raise ValueError(f"workers must be >= 1, got {workers}")
     if backend not in BACKENDS:
         raise ValueError(f"unknown backend {backend!r}; allowed: {BACKENDS}")
+    if spec.sequential:
+        workers, backend = 1, "local"
     bar = tqdm(total=len(tasks), desc=desc, disable=not progress, unit="ep")
     records: list[EpisodeRecord | None] = [None] * len(tasks)
     try:

@@ -43,6 +43,12 @@ class PolicySpec:
             return os.path.splitext(os.path.basename(self.source))[0]
         return self.source
 
+    @property
+    def sequential(self) -> bool:
+        """Whether its episodes must run in order in one process (a controller that keeps
+        a memory across episodes, :meth:`Controller.keeps_memory_across_episodes`)."""
+        return self.kind == "controller" and self.build().keeps_memory_across_episodes()
+
     def build(self):
         """A fresh live policy (in the calling process)."""
         if self.kind == "sb3":

@@ -17,6 +17,7 @@ from homing_train.harness import compare as compare_cli
 from homing_train.harness import eval_command as eval_cli
 from homing_train.harness import field as field_cli
 from homing_train.harness.evaluate import EvalResult, evaluate, run_episode
+from homing_train.harness.policies import policy_spec
 
 ENV_ID = "homing_gym/LocalHoming-v0"
 SHORT = {"max_episode_steps": 8}
@@ -87,6 +88,41 @@ def test_workers_give_the_same_records_as_one_process():
                    progress=False)
     strip = lambda r: [(e.seed, e.trajectory, e.success) for e in r.episodes]  # noqa: E731
     assert strip(one) == strip(two)
+
+
+@dataclass
+class CountingController(Controller):
+    """Counts the episodes it has seen in its process: a memory across episodes."""
+
+    seen: int = 0
+
+    def keeps_memory_across_episodes(self) -> bool:
+        return True
+
+    def on_reset(self) -> None:
+        self.seen += 1
+
+    def decide(self, observation):
+        return Move(0.0, 0.1 * self.seen)
+
+
+def test_a_controller_with_memory_runs_its_episodes_in_order_in_one_process(monkeypatch):
+    """Its episodes depend on the ones before, so workers must not split them: the
+    records are those of one sequence (moves growing with the episode count) and no
+    process pool is started."""
+    import homing_train.harness.evaluate as evaluate_module
+
+    def no_pool(*args, **kwargs):
+        raise AssertionError("a process pool was started")
+
+    monkeypatch.setattr(evaluate_module.mp, "get_context", no_pool)
+    spec = policy_spec(CountingController())
+    assert spec.sequential and not policy_spec("random").sequential
+    result = evaluate(spec, ENV_ID, episodes=3, seed=0, env_kwargs=SHORT, workers=2,
+                      progress=False)
+    travelled = [sum(math.dist(a[:2], b[:2]) for a, b in zip(e.trajectory, e.trajectory[1:]))
+                 for e in result.episodes]
+    assert travelled[0] < travelled[1] < travelled[2], travelled
 
 
 def test_eval_cli_writes_json_and_csv(tmp_path, capsys):
