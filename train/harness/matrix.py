@@ -5,7 +5,10 @@ A cell runs the method on every setting of the protocol with :func:`evaluate` (e
 streamed to ``<setting>.episodes.jsonl``, so an interrupted run resumes), writes each
 setting's result JSON and ``cell.json`` (the summary over all its episodes, per-setting
 success and the command that reproduces it). The matrix writes ``matrix.md``,
-``matrix.csv``, ``matrix.json`` and ``matrix.png`` (a heat map of success).
+``matrix.csv``, ``matrix.json`` and ``matrix.png`` (a heat map of success); ``matrix.md``
+ends with the papers' claims beside our cells (:func:`claims_markdown`) and each method's
+success aggregated over ``local-common`` and ``unseen`` with stratified-bootstrap
+intervals (:func:`aggregate_markdown`).
 
 Shipped policies are run with the settings recorded beside them (their panorama size,
 action type, control period); where a protocol caps the episode length
@@ -13,7 +16,8 @@ action type, control period); where a protocol caps the episode length
 another control period gets the same time, not the same number of steps.
 
 ``python -m homing_train.harness.matrix docs/matrix/matrix.json`` writes the README's
-matrix block (between its two marker lines) from a matrix.json; with ``--merge NEW.json``
+matrix block (between its two marker lines) and the ``matrix.md`` beside it from a
+matrix.json; with ``--merge NEW.json``
 (repeatable) the cells of newer runs (``homing-suite --protocols ... --methods ...``) first
 replace the same protocol and method's cells in it, and its matrix files are rewritten.
 """
@@ -39,7 +43,9 @@ from homing_gym.cli import command_parser  # noqa: E402
 from homing_train.extras import missing_extra  # noqa: E402
 from homing_train.harness.evaluate import EpisodeRecord, evaluate, summarize  # noqa: E402
 from homing_train.harness.policies import shipped_policies  # noqa: E402
-from homing_train.harness.protocols import PROTOCOLS, POLICIES, Protocol  # noqa: E402
+from homing_train.harness.metrics import aggregate_success, wilson_interval  # noqa: E402
+from homing_train.harness.protocols import (POLICIES, PROTOCOLS, Protocol,  # noqa: E402
+                                            episodes_key)
 
 #: The control period (s) that protocols count ``max_episode_steps`` in.
 BASE_PERIOD = 0.1
@@ -238,6 +244,112 @@ def matrix_markdown(cells: Sequence[Cell]) -> str:
                      f"{_pct(s, 'reached_rate', 'reached_ci') if radial else '-'} | "
                      f"{s['spl']:.2f} | "
                      f"{100 * s['final_distance_mean']:.0f} | `{c.command}` |")
+    return "\n".join(lines) + "\n\n" + claims_markdown(cells) + "\n" + aggregate_markdown(cells)
+
+
+def _k_of_n(rate: float, n: int) -> str:
+    return f"{round(rate * n)}/{n}"
+
+
+def claims_markdown(cells: Sequence[Cell]) -> str:
+    """One row per paper claim (:class:`~homing_train.harness.protocols.Claim`) of the
+    protocols in ``cells``: the paper's claim, its numbers and where, its runs with their
+    Wilson interval where it gives them, our success and reached (k/n, Wilson) in the
+    protocol, and how the protocol differs from the paper's setting."""
+    by = {(c.protocol, c.method): c for c in cells}
+    lines = ["### The papers' claims beside ours", "",
+             "The paper's claim as it states it (quoted where in quotes) and the numbers it "
+             "prints; \"paper: reached\" counts the paper's own runs that reached the goal "
+             "(95% Wilson interval) where its figures give them. Ours: the protocol's cell "
+             "above (success: stopped at the goal).", "",
+             "| protocol | method | paper | paper's claim | paper's numbers | paper: reached "
+             "| ours: success % [95% CI] | ours: reached % [95% CI] | how ours differs |",
+             "|---|---|---|---|---|---:|---:|---:|---|"]
+    for protocol in PROTOCOLS.values():
+        if not any(c.protocol == protocol.name for c in cells):
+            continue
+        for claim in protocol.claims:
+            paper = "-"
+            if claim.runs is not None:
+                k, n = claim.runs
+                lo, hi = wilson_interval(k, n)
+                paper = f"{k}/{n} = {100 * k / n:.0f}% [{100 * lo:.0f}, {100 * hi:.0f}]"
+            cell = by.get((protocol.name, claim.method))
+            if cell is None:
+                ours = reached = "not run"
+            else:
+                s, n = cell.summary, cell.summary["episodes"]
+                ours = f"{_pct(s, 'success_rate', 'success_ci')} ({_k_of_n(s['success_rate'], n)})"
+                reached = ("-" if protocol.place else
+                           f"{_pct(s, 'reached_rate', 'reached_ci')} "
+                           f"({_k_of_n(s['reached_rate'], n)})")
+            lines.append(f"| {protocol.label} | {claim.method} | {claim.where} | {claim.text} "
+                         f"| {claim.numbers or '-'} | {paper} | {ours} | {reached} "
+                         f"| {claim.differs} |")
+    return "\n".join(lines) + "\n"
+
+
+#: The protocols aggregated across (:func:`aggregate_markdown`): the two suites that every
+#: homing method and every shipped policy runs, in the same version, renderer and physics.
+AGGREGATE_PROTOCOLS = ("local-common", "unseen")
+
+
+def _episodes_key(cell: Cell, label: str) -> tuple:
+    """:func:`~homing_train.harness.protocols.episodes_key` of the cell's setting
+    ``label``; the cell's own (protocol, version, label) where the protocol or its
+    version is not defined here."""
+    protocol = PROTOCOLS.get(cell.protocol)
+    if protocol is not None and protocol.version == cell.version:
+        for setting in protocol.settings:
+            if setting.label == label:
+                return episodes_key(protocol, setting)
+    return (cell.protocol, cell.version, label)
+
+
+def strata_counts(cells: Sequence[Cell], protocols: Sequence[str] = AGGREGATE_PROTOCOLS
+                  ) -> dict[str, list[tuple[int, int]]]:
+    """(successes, episodes) per distinct setting of ``protocols`` (a setting two of them
+    share counts once, with the first one's episodes), for each method that has a cell in
+    every one of ``protocols``."""
+    by = {(c.protocol, c.method): c for c in cells}
+    methods = [m for m in dict.fromkeys(c.method for c in cells)
+               if all((p, m) in by for p in protocols)]
+    out = {}
+    for m in methods:
+        strata: dict[tuple, tuple[int, int]] = {}
+        for p in protocols:
+            cell = by[(p, m)]
+            for label, setting in cell.settings.items():
+                n = int(setting["episodes"])
+                strata.setdefault(_episodes_key(cell, label),
+                                  (round(setting["success_rate"] * n), n))
+        out[m] = list(strata.values())
+    return out
+
+
+def aggregate_markdown(cells: Sequence[Cell],
+                       protocols: Sequence[str] = AGGREGATE_PROTOCOLS) -> str:
+    """Success of each method over the distinct settings (worlds) of ``protocols``: mean
+    and IQM of the per-setting rates with the stratified-bootstrap interval of
+    :func:`~homing_train.harness.metrics.aggregate_success`."""
+    counts = strata_counts(cells, protocols)
+    names = " and ".join(protocols)
+    lines = [f"### Aggregate over {names}", "",
+             f"Success of each method that ran in all of {names}, over their distinct "
+             "settings (worlds; a setting that two of them share, the same env kwargs and "
+             "seeds, counts once): mean and interquartile mean (IQM, 25% trimmed) of the "
+             "per-setting success rates, every setting weighing alike, % with 95% "
+             "percentile intervals of the stratified bootstrap (episodes resampled within "
+             "each setting from its k/n, 10,000 resamples, seed 0). A method at 0% or "
+             "100% everywhere gets a zero-width interval.", "",
+             "| method | settings | episodes | mean success % [95% CI] | IQM % [95% CI] |",
+             "|---|---:|---:|---:|---:|"]
+    for method, strata in counts.items():
+        a = asdict(aggregate_success(strata))
+        lines.append(f"| {method} | {a['strata']} | {a['episodes']} | "
+                     f"{_pct(a, 'mean', 'mean_ci')} | {_pct(a, 'iqm', 'iqm_ci')} |")
+    if not counts:
+        lines.append("| (no method ran in all of them) | | | | |")
     return "\n".join(lines) + "\n"
 
 
@@ -301,6 +413,10 @@ def main(argv: list[str] | None = None) -> int:
                 cells = merged_cells(cells, load_cells(path))
             write_matrix(cells, target.parent)
             print(f"merged {len(args.merge)} run(s) into {target}")
+        else:
+            markdown = Path(args.readme).parent / Path(args.matrix_json).with_suffix(".md")
+            markdown.write_text(matrix_markdown(load_cells(markdown.with_suffix(".json"))))
+            print(f"wrote {markdown}")
         update_readme(args.readme, args.matrix_json)
     except ValueError as err:
         parser.exit(2, f"error: {err}\n")

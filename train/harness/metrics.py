@@ -10,20 +10,27 @@ Definitions (metres, radians unless named otherwise):
   shortest-path distance from the final position to home;
 * confidence intervals from ``scipy.stats``: a success rate's is the Wilson score interval
   (:func:`wilson_interval`, ``binomtest(...).proportion_ci``), a continuous metric's the
-  percentile bootstrap of its mean (:func:`bootstrap_ci`, ``scipy.stats.bootstrap``, seeded).
+  percentile bootstrap of its mean (:func:`bootstrap_ci`, ``scipy.stats.bootstrap``, seeded);
+* aggregate success over several strata (scenes, protocols): the mean and the interquartile
+  mean (IQM) of the per-stratum success rates, with percentile intervals of the *stratified*
+  bootstrap (:func:`aggregate_success`: episodes resampled within each stratum, as rliable's
+  ``StratifiedBootstrap``; Agarwal et al. 2021, "Deep reinforcement learning at the edge of
+  the statistical precipice").
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Iterable
 
 import numpy as np
 from scipy import stats
 
 from homing_gym.paths import path_length
 
-__all__ = ["bootstrap_ci", "distance_bins", "path_length", "soft_spl", "spl", "wilson_interval"]
+__all__ = ["Aggregate", "aggregate_success", "bootstrap_ci", "distance_bins", "path_length",
+           "soft_spl", "spl", "wilson_interval"]
 
 
 def spl(success: bool, shortest: float, path: float) -> float:
@@ -54,10 +61,83 @@ def bootstrap_ci(values, confidence: float = 0.95, n_boot: int = 2000,
         return math.nan, math.nan
     if np.all(x == x[0]):
         return float(x[0]), float(x[0])
-    ci = stats.bootstrap((x,), np.mean, confidence_level=confidence, n_resamples=n_boot,
-                         method="percentile", random_state=np.random.default_rng(seed),
+    return _percentile_bootstrap((x,), np.mean, confidence, n_boot, seed)
+
+
+def _percentile_bootstrap(samples, statistic, confidence: float, n_boot: int,
+                          seed: int) -> tuple[float, float]:
+    """Percentile interval of ``statistic(*samples, axis=-1)`` (vectorised) under the
+    bootstrap that resamples each sample on its own (``scipy.stats.bootstrap``, unpaired,
+    seeded)."""
+    ci = stats.bootstrap(tuple(samples), statistic, confidence_level=confidence,
+                         n_resamples=n_boot, method="percentile", paired=False,
+                         random_state=np.random.default_rng(seed),
                          vectorized=True).confidence_interval
     return float(ci.low), float(ci.high)
+
+
+@dataclass(frozen=True)
+class Aggregate:
+    """Success aggregated over strata: the mean and the IQM (25% trimmed mean) of the
+    per-stratum success rates (fractions), each with its stratified-bootstrap interval."""
+
+    strata: int
+    episodes: int
+    mean: float
+    mean_ci: tuple[float, float]
+    iqm: float
+    iqm_ci: tuple[float, float]
+
+
+def _mean_rate(*strata, axis: int = -1):
+    return np.mean(np.stack([s.mean(axis=axis) for s in strata], axis=-1), axis=-1)
+
+
+def _iqm_rate(*strata, axis: int = -1):
+    return stats.trim_mean(np.stack([s.mean(axis=axis) for s in strata], axis=-1), 0.25,
+                           axis=-1)
+
+
+def aggregate_success(counts: Iterable[tuple[int, int]], confidence: float = 0.95,
+                      n_boot: int = 10_000, seed: int = 0) -> Aggregate:
+    """Mean and IQM over strata of the success rate, from ``counts``: one
+    ``(successes, episodes)`` pair per stratum (e.g. per scene of a protocol).
+
+    Every stratum counts once whatever its episodes (rliable's convention: tasks weigh
+    alike); the IQM is ``scipy.stats.trim_mean(rates, 0.25)``, which with fewer than 4
+    strata trims nothing and equals the mean. Intervals: percentile, stratified bootstrap
+    (episodes resampled with replacement within each stratum, strata kept), seeded. Episodes
+    are Bernoulli trials, so a stratum's ``k`` of ``n`` is all the bootstrap needs: it
+    resamples ``k`` ones and ``n - k`` zeros, whose order does not matter. A stratum at 0%
+    or 100% (one episode included) stays there in every resample and enters as a constant;
+    where all are, the interval has zero width, and the per-stratum Wilson intervals are
+    the honest bound."""
+    counts = [(int(k), int(n)) for k, n in counts]
+    if not counts:
+        raise ValueError("aggregate_success needs at least one stratum")
+    for k, n in counts:
+        if n < 1 or not 0 <= k <= n:
+            raise ValueError(f"each stratum needs 0 <= successes <= episodes >= 1, got {k}/{n}")
+    _check_confidence(confidence)
+    rates = np.array([k / n for k, n in counts])
+    mean, iqm = float(rates.mean()), float(stats.trim_mean(rates, 0.25))
+    varying = [np.repeat([1.0, 0.0], [k, n - k]) for k, n in counts if 0 < k < n]
+    if not varying:                        # no stratum can vary under resampling
+        return Aggregate(len(counts), sum(n for _, n in counts), mean, (mean, mean), iqm,
+                         (iqm, iqm))
+    fixed = [np.full(1, k / n) for k, n in counts if k in (0, n)]
+
+    def with_fixed(statistic):
+        def of(*strata, axis: int = -1):
+            shape = strata[0].shape[:-1] + (1,)
+            return statistic(*strata, *(np.broadcast_to(f, shape) for f in fixed), axis=axis)
+        return of
+
+    return Aggregate(len(counts), sum(n for _, n in counts), mean,
+                     _percentile_bootstrap(varying, with_fixed(_mean_rate), confidence,
+                                           n_boot, seed),
+                     iqm, _percentile_bootstrap(varying, with_fixed(_iqm_rate), confidence,
+                                                n_boot, seed))
 
 
 def wilson_interval(successes: int, n: int, confidence: float = 0.95) -> tuple[float, float]:

@@ -13,6 +13,10 @@ continuous action below the stop threshold) within ``success_radius`` of the goa
 ``Protocol.place``). "Reached" (a second column) counts episodes that came within the
 radius at any time, stopped or not (not given where the place rule is not a radius).
 
+Each paper protocol carries the paper's claims (:class:`Claim`): what the paper reports for
+one of our methods, its numbers as printed, where (section, figure, table), and how our
+setting differs from the paper's; the matrix sets them beside our cells.
+
 ``homing-eval --protocol NAME --policy METHOD`` runs one method on a protocol;
 ``homing-suite --protocols ...`` runs every applicable method on each and writes the
 methods x protocols matrix. Changing what a protocol does means a new ``version``.
@@ -20,6 +24,7 @@ methods x protocols matrix. Changing what a protocol does means a new ``version`
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass, field
 from typing import Callable, Sequence
@@ -136,6 +141,27 @@ class Setting:
 
 
 @dataclass(frozen=True)
+class Claim:
+    """What a paper reports for the method ``method`` (ours) in the setting a protocol
+    reproduces: ``text`` (quoted where in quotes), ``numbers`` as the paper prints them
+    ("" where it prints none), ``where`` (paper, section, figure or table), ``runs`` =
+    (runs that reached the goal, runs) where the paper's own figures give them, and
+    ``differs``: how our protocol differs from the paper's setting."""
+
+    method: str
+    text: str
+    numbers: str
+    where: str
+    differs: str
+    runs: tuple[int, int] | None = None
+
+    def __post_init__(self) -> None:
+        if self.runs is not None and not 0 <= self.runs[0] <= self.runs[1] >= 1:
+            raise ValueError(f"runs must be (reached, runs) with 0 <= reached <= runs >= 1, "
+                             f"got {self.runs}")
+
+
+@dataclass(frozen=True)
 class Protocol:
     """A named, versioned episode suite; see the module docstring."""
 
@@ -146,7 +172,7 @@ class Protocol:
     methods: tuple[str, ...]
     episodes: int = 10                 # per setting, the default of the matrix
     seed: int = 0
-    paper: str = ""                    # the paper's claim, beside our number
+    claims: tuple[Claim, ...] = ()     # the paper's, beside our numbers
     privileged: str = ""               # anything beyond pixels the protocol gives
     place: str = ""                    # a place rule other than the radius (the task's)
 
@@ -161,6 +187,14 @@ class Protocol:
         """The ``homing-eval`` command that reproduces one matrix cell."""
         extra = f" --episodes {episodes}" if episodes not in (None, self.episodes) else ""
         return f"homing-eval --protocol {self.name} --policy {method}{extra} --out OUT.json"
+
+
+def episodes_key(protocol: Protocol, setting: Setting) -> tuple:
+    """Equal for two settings, of one protocol or two, that run the same episodes: the
+    same env id and env kwargs, the same episode draw and the same seed (``unseen``'s
+    hallway, lab and house are ``local-common``'s)."""
+    return (setting.env_id, json.dumps(setting.kwargs(), sort_keys=True), setting.tasks,
+            protocol.seed)
 
 
 def _hong_one_foot(episodes: int, seed: int) -> list[Task]:
@@ -203,20 +237,38 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
                  {"scene": "hallway", "drive": "synchro", "panorama_shape": [60, 360],
                   "max_episode_steps": 200}, _hong_one_foot),),
         ("snapshot", "warping", "oracle", "random"), episodes=10,
-        paper="§5: a 17-target route, targets 1 ft apart, traversed: every 1-ft homing "
-              "succeeded (>= 95% expected)"),
+        claims=(Claim(
+            "snapshot", "17 hallway images taken at targets about 1 ft apart; the robot, "
+            "placed 1 ft from the first, homed to each in sequence and \"was able to traverse "
+            "this path successfully and reach the final target location\"",
+            "17 targets, about 1 ft apart; start 1 ft from the first; no error figures",
+            "Hong et al. 1991, §5",
+            "the paper: one route on a real robot, consecutive homings (an error carries to "
+            "the next), no success radius stated; ours: independent homings to random homes "
+            "in our hallway model, 1 ft away, stopped within 0.15 m",
+            runs=(17, 17)),)),
     Protocol(
         "yukim", 1, "Yu & Kim: the arena, the nest among the four landmarks, starts "
         "0.3-1.4 m away in the four distance bins of Fig. 6, random headings",
         (Setting("arena, nest", LOCAL, {"scene": "arena", "max_episode_steps": 300},
                  _yukim_nest),),
         ("distance", "warping", "snapshot", "oracle", "random", POLICIES), episodes=12,
-        paper="Fig. 6: distance estimation homes in most runs up to 1.4 m"),
+        claims=tuple(Claim(
+            method, text, "100 trials per start distance, in simulation, no reference "
+            "compass; the rates are plotted, not printed", "Yu & Kim, §III, Fig. 6",
+            "the paper: its own simulator of the 240 cm arena, success criterion not "
+            "stated; ours: rendered panoramas of our arena model in closed loop, 3 episodes "
+            "per distance bin (0.3-1.4 m), 300 steps, stopped within 0.15 m")
+            for method, text in (
+                ("distance", "distance estimation \"shows constantly high probability of "
+                             "returning to the nest\", \"regardless of the distance\""),
+                ("warping", "the pixel-based image matching of Franz et al. \"declines "
+                            "rapidly as the mobile agent gets farther from the nest\"")))),
     Protocol(
         "yukim-anywhere", 1, "the arena with homes anywhere (not the paper's setting: "
         "most homes lie outside the landmarks' quadrilateral)",
         (Setting("arena, anywhere", LOCAL, {"scene": "arena"}),),
-        HOMING_METHODS, episodes=10, paper="(not a paper setting)"),
+        HOMING_METHODS, episodes=10),
     Protocol(
         "bekris-lab", 1, "Bekris et al.: the lab, goals A-F, random starts 0.5-3 m away "
         "(Fig. 11)",
@@ -224,21 +276,61 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
                  _bekris_goals),),
         ("bearing", "bearing-basic", "bearing-complementary", "warping", "oracle",
          "random"), episodes=12, seed=11,
-        paper="Fig. 11: every goal reached, mean error 1.45-4.65 cm"),
+        claims=(
+            Claim("bearing", "the unified law, run 30 times to each of the 6 marked "
+                  "positions (180 runs): accuracy \"in the order of a very few centimeters "
+                  "for all goal positions\"; no failure reported",
+                  "mean error A 1.45, B 4.65, C 2.85, D 2.55, E 3.22, F 2.28 cm; "
+                  "s.d. 1.13-2.10 cm", "Bekris et al., §5, Fig. 11",
+                  "the paper: a real robot tracking three coloured posters, its starts "
+                  "not given; ours: the lab model, 2 random starts per goal 0.5-3 m away, "
+                  "stopped within 0.15 m (the paper's figure is the final error)",
+                  runs=(180, 180)),
+            *(Claim(method, text, numbers, "Bekris et al., §5, Fig. 10",
+                    "Fig. 10: goals A, C and E only, 3 starts in each of 3 start regions; "
+                    "ours: goals A-F, 2 random starts per goal, so the share of goals "
+                    "outside the law's reachability set differs; stopped within 0.15 m",
+                    runs=runs)
+              for method, text, numbers, runs in (
+                  ("bearing-basic", "the basic law \"fails to reach certain goal positions, "
+                   "independently of the starting position\": E from every start",
+                   "A and C reached from all 9 starts (0.0-11.5 cm), E: Fail in all 9",
+                   (18, 27)),
+                  ("bearing-complementary", "the complementary law \"fails to reach "
+                   "certain goal positions, independently of the starting position\": A "
+                   "and C from every start",
+                   "E reached from all 9 starts (2.5-9.0 cm), A and C: Fail in all 9",
+                   (9, 27)))))),
     Protocol(
         "briggs-corridors", 1, "Briggs et al.: LandmarkNavigation-v0 in the corridors",
         (Setting("corridors", "homing_gym/LandmarkNavigation-v0", {"scene": "corridors"}),),
         ("selfsimilar", "oracle", "random"), episodes=6,
         place="stopped in front of the goal landmark (the task's rule: at most 1.2 m from "
               "the panel, within 30 deg of its normal, facing it)",
-        paper="§5: the robot reached its goal landmarks in the building's corridors"),
+        claims=(Claim(
+            "selfsimilar", "a navigation system \"reliable and robust with respect to "
+            "landmark orientation, varying lighting conditions, and distances to the "
+            "landmarks\"; navigation plans routes over the landmark visibility graph (§4.2, "
+            "§4.3)", "", "Briggs et al. 2000, §5",
+            "the paper reports no navigation runs, success rate or error; ours: "
+            "LandmarkNavigation-v0 in our corridors, the task's place rule"),)),
     Protocol(
         "shiraishi-house", 1, "Shiraishi & Sawasaki: WorkLocations-v0 in the house, "
         "success radius 0.10 m (the env's and the paper's)",
         (Setting("house", "homing_gym/WorkLocations-v0",
                  {"scene": "house", "success_radius": 0.1}),),
         ("multires", "oracle", "random"), episodes=6,
-        paper="§4: arrival within 10 cm and 2 deg of each work location"),
+        claims=(Claim(
+            "multires", "\"arrival at the goal was generally recognized with an accuracy "
+            "of 10 centimeters or better\" (§4 (1)); self-localisation at a work location "
+            "(§4 (2-2), Fig. 10): location error \"less than 10 centimeters\", direction "
+            "error \"less than 2 degrees\"",
+            "arrival <= 10 cm (\"generally\"); location < 10 cm and direction < 2 deg, "
+            "measured within 50 cm of where the points were taught; no run counts",
+            "Shiraishi & Sawasaki, §4 (1), §4 (2-2), Fig. 10",
+            "the paper: arrival on a dolly pushed by hand along the displayed deviation, "
+            "localisation on an HRP robot; ours: WorkLocations-v0 in our house model in "
+            "closed loop, stopped within 0.10 m"),)),
     Protocol(
         "local-common", 2, "one LocalHoming suite for every homing method and policy: "
         "arena, hallway, lab, house and the procedural random_rooms and random_nature, "

@@ -119,3 +119,44 @@ def test_clearances_hand_computed_for_a_wall_a_box_and_a_cylinder():
     expected = [0.5, 0.25, 0.5, 0.1, 0.5, 0.1, 0.0]
     assert np.allclose(clearances(scene, points), expected)
     assert [clearance(scene, p) for p in points] == pytest.approx(expected)
+
+
+def test_aggregate_success_hand_computed_point_estimates():
+    from homing_train.harness.metrics import aggregate_success
+
+    # rates 0.2, 0.4, 0.6, 1.0: mean 0.55; the IQM trims one stratum at each end
+    a = aggregate_success([(1, 5), (2, 5), (3, 5), (5, 5)])
+    assert (a.strata, a.episodes) == (4, 20)
+    assert a.mean == pytest.approx(0.55) and a.iqm == pytest.approx(0.5)
+    assert a.mean_ci[0] < a.mean < a.mean_ci[1] and a.iqm_ci[0] < a.iqm < a.iqm_ci[1]
+    # strata weigh alike whatever their episodes: (1/2 + 1/10) / 2, not 2/12
+    assert aggregate_success([(1, 2), (1, 10)]).mean == pytest.approx(0.3)
+    assert aggregate_success([(1, 5), (2, 5)], seed=4) == aggregate_success([(1, 5), (2, 5)],
+                                                                            seed=4)
+
+
+def test_aggregate_interval_is_the_stratified_one_and_shrinks_with_episodes():
+    from homing_train.harness.metrics import aggregate_success
+
+    small = aggregate_success([(2, 10), (8, 10)])
+    big = aggregate_success([(200, 1000), (800, 1000)])
+    assert small.mean == big.mean == pytest.approx(0.5)
+    assert small.mean_ci[0] < big.mean_ci[0] < 0.5 < big.mean_ci[1] < small.mean_ci[1]
+    # resampling within each stratum: var = (0.16/1000 + 0.16/1000) / 4; pooling the 2000
+    # episodes (0.25/2000) would give a half-width of 0.0219 instead of 0.0175
+    half = 1.96 * math.sqrt((0.16 / 1000 + 0.16 / 1000) / 4)
+    assert big.mean_ci[0] == pytest.approx(0.5 - half, abs=0.002)
+    assert big.mean_ci[1] == pytest.approx(0.5 + half, abs=0.002)
+
+
+def test_aggregate_of_strata_that_cannot_vary_and_bad_input():
+    from homing_train.harness.metrics import aggregate_success
+
+    a = aggregate_success([(0, 5), (5, 5), (1, 1)])
+    assert a.mean == pytest.approx(2 / 3) and a.mean_ci == (a.mean, a.mean)
+    # one varying stratum among constant ones: only it moves the mean, by 1/3 of its own
+    b = aggregate_success([(0, 5), (5, 5), (1, 2)])
+    assert b.mean_ci == pytest.approx((1 / 3, 2 / 3))
+    for bad in ([], [(3, 2)], [(0, 0)], [(-1, 4)]):
+        with pytest.raises(ValueError):
+            aggregate_success(bad)

@@ -210,3 +210,97 @@ def test_field_in_a_protocol_uses_its_env_and_fixed_home(tmp_path):
     with pytest.raises(SystemExit):
         field.main(["--protocol", "yukim", "--policy", "warping", "--scene", "lab",
                     "--out", str(out)])
+
+
+PAPER_PROTOCOLS = ("hong1991", "yukim", "bekris-lab", "briggs-corridors", "shiraishi-house")
+
+
+def test_every_paper_protocol_states_its_papers_claim_and_where():
+    from homing_train.harness.protocols import Claim
+
+    for name in PAPER_PROTOCOLS:
+        p = protocol(name)
+        assert p.claims, name
+        for claim in p.claims:
+            assert claim.method in p.methods and claim.text and claim.differs
+            assert "§" in claim.where or "Fig." in claim.where
+    assert protocol("hong1991").claims[0].runs == (17, 17)       # §5: all 17 homings
+    assert {c.method: c.runs for c in protocol("bekris-lab").claims} == {
+        "bearing": (180, 180), "bearing-basic": (18, 27), "bearing-complementary": (9, 27)}
+    assert not protocol("local-common").claims and not protocol("yukim-anywhere").claims
+    with pytest.raises(ValueError, match="runs"):
+        Claim("x", "t", "", "§1", "d", runs=(5, 3))
+
+
+def _cell(name, method, settings):
+    """A cell with per-setting ``(k, n)`` and the summary over them (Wilson CIs)."""
+    from homing_train.harness.metrics import wilson_interval
+
+    k, n = sum(s[0] for s in settings.values()), sum(s[1] for s in settings.values())
+    summary = {"episodes": n, "success_rate": k / n, "success_ci": list(wilson_interval(k, n)),
+               "reached_rate": k / n, "reached_ci": list(wilson_interval(k, n)), "spl": 0.5,
+               "final_distance_mean": 0.1}
+    return Cell(name, PROTOCOLS[name].version if name in PROTOCOLS else 1, method,
+                f"homing-eval --protocol {name} --policy {method} --out OUT.json", summary,
+                {label: {"episodes": n_, "success_rate": k_ / n_, "reached_rate": k_ / n_}
+                 for label, (k_, n_) in settings.items()})
+
+
+def test_claims_table_sets_the_papers_runs_beside_our_cell():
+    from homing_train.harness.matrix import claims_markdown
+
+    text = claims_markdown([_cell("bekris-lab", "bearing-basic", {"lab, A-F": (8, 12)})])
+    row = next(line for line in text.splitlines() if "| bearing-basic |" in line)
+    # Fig. 10: 18 of 27 runs reached (Wilson 95%: 47.8-81.4%); ours 8 of 12
+    assert "| 18/27 = 67% [48, 81] | 67 [39, 86] (8/12) |" in row
+    assert "Fig. 10" in row and "goals A, C and E only" in row
+    unrun = next(line for line in text.splitlines() if "| bearing |" in line)
+    assert "180/180" in unrun and "not run" in unrun
+    assert "hong1991" not in text                  # only protocols that are in the matrix
+
+
+def test_aggregate_over_two_protocols_from_their_counts():
+    from homing_train.harness.matrix import aggregate_markdown, strata_counts
+    from homing_train.harness.metrics import aggregate_success
+
+    def cells(n):
+        return [_cell("p1", "a", {"s": (3 * n // 10, n)}),
+                _cell("p2", "a", {"s": (7 * n // 10, n)}),
+                _cell("p1", "b", {"s": (n, n)})]             # b did not run p2: left out
+
+    assert strata_counts(cells(10), ("p1", "p2")) == {"a": [(3, 10), (7, 10)]}
+    text = aggregate_markdown(cells(10), ("p1", "p2"))
+    assert "| a | 2 | 20 | 50 [" in text and "| b |" not in text
+    small, big = (aggregate_success(strata_counts(cells(n), ("p1", "p2"))["a"])
+                  for n in (10, 100))
+    assert small.mean == big.mean == small.iqm == 0.5          # 2 strata: IQM trims none
+    assert small.mean_ci[0] < big.mean_ci[0] < 0.5 < big.mean_ci[1] < small.mean_ci[1]
+
+
+def test_a_setting_two_protocols_share_counts_once_in_the_aggregate():
+    from homing_train.harness.matrix import strata_counts
+    from homing_train.harness.protocols import episodes_key
+
+    common, unseen = protocol("local-common"), protocol("unseen")
+    keys = {s.label: episodes_key(common, s) for s in common.settings}
+    shared = [s.label for s in unseen.settings if episodes_key(unseen, s) in keys.values()]
+    assert shared == ["hallway", "lab", "house"]             # the same seeds, the same kwargs
+    cells = [_cell("local-common", "m", {s.label: (i % 6, 5) for i, s in
+                                         enumerate(common.settings)}),
+             _cell("unseen", "m", {s.label: (1, 5) for s in unseen.settings})]
+    counts = strata_counts(cells)["m"]
+    assert len(counts) == 9 and counts[:6] == [(i % 6, 5) for i in range(6)]
+    assert counts[6:] == [(1, 5)] * 3                        # the held-out procedural worlds
+
+
+def test_matrix_command_rewrites_the_markdown_and_readme_block(tmp_path):
+    from homing_train.harness.matrix import README_BEGIN, README_END, main, matrix_markdown
+
+    cells = [_cell("yukim", "distance", {"arena, nest": (2, 12)})]
+    (tmp_path / "m").mkdir()
+    (tmp_path / "m/matrix.json").write_text(json.dumps([c.__dict__ for c in cells]))
+    (tmp_path / "README.md").write_text(f"top\n{README_BEGIN}\nold\n{README_END}\nend\n")
+    assert main(["m/matrix.json", "--readme", str(tmp_path / "README.md")]) == 0
+    assert (tmp_path / "m/matrix.md").read_text() == matrix_markdown(cells)
+    assert "Yu & Kim, §III, Fig. 6" in (tmp_path / "m/matrix.md").read_text()
+    assert "| distance |" in (tmp_path / "README.md").read_text()
