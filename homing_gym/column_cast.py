@@ -131,7 +131,7 @@ def cast_columns(tris: np.ndarray, normals: np.ndarray, closed: np.ndarray,
     (``-1``: nothing) and ``weights (H, W, 3)`` the barycentric weights of the hit.
     """
     H, W = tan_elev.shape
-    depth = np.full((H, W), np.inf)
+    depth = np.full((W, H), np.inf)           # column by column, like the loops below
     hit[:] = -1
     cos_b = np.cos(yaw + beta)
     sin_b = np.sin(yaw + beta)
@@ -167,8 +167,8 @@ def cast_columns(tris: np.ndarray, normals: np.ndarray, closed: np.ndarray,
                         continue
                     u = min(max(fa / (fa - fb), 0.0), 1.0)
                     dist = seg[0, 0] + u * (seg[1, 0] - seg[0, 0])
-                    if dist < depth[i, j]:
-                        depth[i, j] = dist
+                    if dist < depth[j, i]:
+                        depth[j, i] = dist
                         hit[i, j] = t
                         for k in range(3):
                             weights[i, j, k] = seg[0, 2 + k] + u * (seg[1, 2 + k] - seg[0, 2 + k])
@@ -202,15 +202,48 @@ def _texel(atlas: np.ndarray, levels: np.ndarray, m: int, s: float, v: float,
 
 
 @njit(cache=True, error_model="numpy")
+def lit_colors(colors: np.ndarray, normals: np.ndarray, tris: np.ndarray, light: np.ndarray,
+               ambient: float, diffuse: float, origin: np.ndarray) -> np.ndarray:
+    """Each triangle's colour (``(N, 3)``) times ``ambient + diffuse * max(0, n . l)``
+    seen from ``origin``: Lambert with the unit light direction ``l``, ``n`` the
+    triangle's normal turned towards the camera (a face turned away from the light gets
+    the ambient term alone)."""
+    lit = np.empty((colors.shape[0], 3))
+    for t in range(colors.shape[0]):
+        towards = 0.0
+        cos_light = 0.0
+        for d in range(3):
+            towards += normals[t, d] * (origin[d] - tris[t, 0, d])
+            cos_light += normals[t, d] * light[d]
+        if towards < 0.0:
+            cos_light = -cos_light
+        elif towards == 0.0:
+            cos_light = 0.0
+        factor = ambient + diffuse * max(cos_light, 0.0)
+        for c in range(3):
+            lit[t, c] = colors[t, c] * factor
+    return lit
+
+
+#: float32 constants of the final quantisation (the same arithmetic as a float32 image
+#: ``* 255 + 0.5`` truncated to uint8, i.e. rounded half up).
+_SCALE_255 = np.float32(255.0)
+_HALF = np.float32(0.5)
+
+
+@njit(cache=True, error_model="numpy")
 def shade(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.ndarray,
           uvs: np.ndarray, atlas: np.ndarray, levels: np.ndarray, first_level: np.ndarray,
           texel_density: np.ndarray, tris: np.ndarray, normals: np.ndarray,
           origin: np.ndarray, ray_spacing: float, sky: np.ndarray, out: np.ndarray,
           shaded: np.ndarray, shadow_depth: np.ndarray, shadow_axes: np.ndarray,
           shadow_origin: np.ndarray, shadow_cell: float) -> None:
-    """Colour per pixel (``out (H, W, 3)`` in ``[0, 1]``): ``sky`` where nothing was hit,
-    else the triangle's lit colour ``base`` times its texture (``u`` left to right, ``v``
-    bottom to top, wrapped), clipped.
+    """The image ``out (H/k, W/k, 3)`` (uint8) from the ``(H, W)`` rays' hits: each
+    pixel the mean of its ``k x k`` rays' colours (``k = H / out.shape[0]``), each colour
+    ``sky`` where nothing was hit, else the triangle's lit colour ``base`` times its
+    texture (``u`` left to right, ``v`` bottom to top, wrapped), clipped to ``[0, 1]``.
+    The mean is summed in float32 in row-major order (for ``k = 2`` bit for bit OpenCV's
+    box average, ``INTER_AREA``), then scaled to 0-255 and rounded half up.
 
     Textures are filtered like a camera's pixel (trilinear mip-mapping): the ray's
     footprint on the surface, ``r * ray_spacing / |cos(incidence)|`` metres (``r`` the
@@ -226,59 +259,68 @@ def shade(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.nd
     Cast shadows (:mod:`homing_gym.shadows`; off when ``shadow_depth`` is empty): a point
     in the shadow of the map takes ``shaded[t]`` (the ambient light alone) instead of
     ``base[t]``."""
-    H, W = hit.shape
+    rows, cols = out.shape[0], out.shape[1]
+    k = hit.shape[0] // rows
+    mean = np.float32(1.0 / (k * k))
     shadows = shadow_depth.size > 0
     near, far = np.empty(3), np.empty(3)
-    for i in range(H):
-        for j in range(W):
-            t = hit[i, j]
-            if t < 0:
-                out[i, j] = sky
-                continue
-            r, g, b = base[t, 0], base[t, 1], base[t, 2]
-            k = texture[t]
-            px = py = pz = 0.0
-            if k >= 0 or shadows:
-                for c in range(3):
-                    px += weights[i, j, c] * tris[t, c, 0]
-                    py += weights[i, j, c] * tris[t, c, 1]
-                    pz += weights[i, j, c] * tris[t, c, 2]
-            if shadows and (r, g, b) != (shaded[t, 0], shaded[t, 1], shaded[t, 2]):
-                facing = (normals[t, 0] * shadow_axes[2, 0] + normals[t, 1] * shadow_axes[2, 1]
-                          + normals[t, 2] * shadow_axes[2, 2])
-                if in_shadow(shadow_depth, shadow_axes, shadow_origin, shadow_cell,
-                             px, py, pz, facing):
-                    r, g, b = shaded[t, 0], shaded[t, 1], shaded[t, 2]
-            if k >= 0:
-                s = v = 0.0
-                for c in range(3):
-                    s += weights[i, j, c] * uvs[t, c, 0]
-                    v += weights[i, j, c] * uvs[t, c, 1]
-                dx, dy, dz = px - origin[0], py - origin[1], pz - origin[2]
-                length = math.sqrt(dx * dx + dy * dy + dz * dz)
-                facing = abs(normals[t, 0] * dx + normals[t, 1] * dy + normals[t, 2] * dz)
-                cos_in = max(facing / max(length, 1e-9), 0.1)
-                texels = length * ray_spacing / cos_in * texel_density[t]
-                lod = math.log2(texels) if texels > 1.0 else 0.0
-                top = first_level[k + 1] - first_level[k] - 1
-                lod = min(lod, float(top))
-                m = int(lod)
-                frac = lod - m
-                base_level = first_level[k]
-                if texel_density[t] == 0.0:      # one texel spread over the face (no UVs)
-                    off, h, w = (levels[base_level, 0], levels[base_level, 1],
-                                 levels[base_level, 2])
-                    col = min(max(int((s % 1.0) * w), 0), w - 1)
-                    row = min(max(int((1.0 - v % 1.0) * h), 0), h - 1)
-                    for c in range(3):
-                        near[c] = atlas[off + 3 * (row * w + col) + c]
-                else:
-                    _texel(atlas, levels, base_level + m, s, v, near)
-                if frac > 0.0 and m < top and texel_density[t] > 0.0:
-                    _texel(atlas, levels, base_level + m + 1, s, v, far)
-                    for c in range(3):
-                        near[c] = (1 - frac) * near[c] + frac * far[c]
-                r, g, b = r * near[0], g * near[1], b * near[2]
-            out[i, j, 0] = min(max(r, 0.0), 1.0)
-            out[i, j, 1] = min(max(g, 0.0), 1.0)
-            out[i, j, 2] = min(max(b, 0.0), 1.0)
+    acc = np.empty(3, np.float32)
+    for jo in range(cols):
+        for io in range(rows):
+            acc[:] = 0.0
+            for i in range(io * k, io * k + k):
+                for j in range(jo * k, jo * k + k):
+                    t = hit[i, j]
+                    if t < 0:
+                        r, g, b = sky[0], sky[1], sky[2]
+                    else:
+                        r, g, b = base[t, 0], base[t, 1], base[t, 2]
+                        tex = texture[t]
+                        px = py = pz = 0.0
+                        if tex >= 0 or shadows:
+                            for c in range(3):
+                                px += weights[i, j, c] * tris[t, c, 0]
+                                py += weights[i, j, c] * tris[t, c, 1]
+                                pz += weights[i, j, c] * tris[t, c, 2]
+                        if shadows and (r, g, b) != (shaded[t, 0], shaded[t, 1], shaded[t, 2]):
+                            facing = (normals[t, 0] * shadow_axes[2, 0] + normals[t, 1] * shadow_axes[2, 1]
+                                      + normals[t, 2] * shadow_axes[2, 2])
+                            if in_shadow(shadow_depth, shadow_axes, shadow_origin, shadow_cell,
+                                         px, py, pz, facing):
+                                r, g, b = shaded[t, 0], shaded[t, 1], shaded[t, 2]
+                        if tex >= 0:
+                            s = v = 0.0
+                            for c in range(3):
+                                s += weights[i, j, c] * uvs[t, c, 0]
+                                v += weights[i, j, c] * uvs[t, c, 1]
+                            dx, dy, dz = px - origin[0], py - origin[1], pz - origin[2]
+                            length = math.sqrt(dx * dx + dy * dy + dz * dz)
+                            facing = abs(normals[t, 0] * dx + normals[t, 1] * dy + normals[t, 2] * dz)
+                            cos_in = max(facing / max(length, 1e-9), 0.1)
+                            texels = length * ray_spacing / cos_in * texel_density[t]
+                            lod = math.log2(texels) if texels > 1.0 else 0.0
+                            top = first_level[tex + 1] - first_level[tex] - 1
+                            lod = min(lod, float(top))
+                            m = int(lod)
+                            frac = lod - m
+                            base_level = first_level[tex]
+                            if texel_density[t] == 0.0:      # one texel spread over the face (no UVs)
+                                off, h, w = (levels[base_level, 0], levels[base_level, 1],
+                                             levels[base_level, 2])
+                                col = min(max(int((s % 1.0) * w), 0), w - 1)
+                                row = min(max(int((1.0 - v % 1.0) * h), 0), h - 1)
+                                for c in range(3):
+                                    near[c] = atlas[off + 3 * (row * w + col) + c]
+                            else:
+                                _texel(atlas, levels, base_level + m, s, v, near)
+                            if frac > 0.0 and m < top and texel_density[t] > 0.0:
+                                _texel(atlas, levels, base_level + m + 1, s, v, far)
+                                for c in range(3):
+                                    near[c] = (1 - frac) * near[c] + frac * far[c]
+                            r, g, b = r * near[0], g * near[1], b * near[2]
+                        r, g, b = min(max(r, 0.0), 1.0), min(max(g, 0.0), 1.0), min(max(b, 0.0), 1.0)
+                    acc[0] += np.float32(r)
+                    acc[1] += np.float32(g)
+                    acc[2] += np.float32(b)
+            for c in range(3):
+                out[io, jo, c] = np.uint8(acc[c] * mean * _SCALE_255 + _HALF)

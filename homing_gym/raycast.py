@@ -38,7 +38,7 @@ from functools import lru_cache
 import cv2
 import numpy as np
 
-from homing_gym.column_cast import cast_columns, shade
+from homing_gym.column_cast import cast_columns, lit_colors, shade
 from homing_gym.panorama import (DEFAULT_LIGHTING, CameraConfig, Lighting, column_bearing,
                                  photometric, row_elevation)
 from homing_gym.shadows import ShadowMap, shadow_map
@@ -64,7 +64,7 @@ def panorama_rays(shape: tuple[int, int], vfov: float, k: int = 1):
     H, W = shape
     beta = column_bearing(_centres(W, k), W)
     tan = np.tan(row_elevation(_centres(H, k), H, vfov))
-    return beta, np.ascontiguousarray(np.broadcast_to(tan[:, None], (k * H, k * W)))
+    return beta, np.asfortranarray(np.broadcast_to(tan[:, None], (k * H, k * W)))
 
 
 @lru_cache(maxsize=32)
@@ -73,7 +73,7 @@ def perspective_rays(width: int, height: int, focal: float, k: int = 1):
     ``(i + 0.5, j + 0.5)``, focal length in pixels)."""
     left = (width / 2 - _centres(width, k)) / focal
     up = (height / 2 - _centres(height, k)) / focal
-    return np.arctan(left), up[:, None] / np.sqrt(1 + left[None, :] ** 2)
+    return np.arctan(left), np.asfortranarray(up[:, None] / np.sqrt(1 + left[None, :] ** 2))
 
 
 def mip_levels(texture: np.ndarray) -> list[np.ndarray]:
@@ -134,6 +134,7 @@ class RayCaster:
         #: Cast shadows (:mod:`homing_gym.shadows`); maps cached per light direction.
         self.shadows = shadows
         self._shadow_maps: dict[tuple, ShadowMap] = {}
+        self._scratch: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
 
     def _shadow_map(self, lighting: Lighting) -> ShadowMap:
         key = tuple(lighting.direction)
@@ -141,38 +142,37 @@ class RayCaster:
             self._shadow_maps[key] = shadow_map(self._tris, lighting.direction)
         return self._shadow_maps[key]
 
-    def _lit_colors(self, lighting: Lighting, origin: np.ndarray) -> np.ndarray:
-        """Each triangle's colour times ``ambient + diffuse * max(0, n . l)`` seen from
-        ``origin`` (before textures), ``n`` turned towards the camera."""
-        light = np.asarray(lighting.direction, np.float64)
-        towards = np.einsum("ij,ij->i", self._normals, origin - self._tris[:, 0])
-        lambert = np.maximum(self._normals @ (light / np.linalg.norm(light))
-                             * np.sign(towards), 0.0)
-        return self.mesh.colors * (lighting.ambient + lighting.diffuse * lambert)[:, None]
+    def _buffers(self, H: int, W: int) -> tuple[np.ndarray, np.ndarray]:
+        """The caster's per-ray outputs for ``H x W`` rays (triangle index, barycentric
+        weights), kept between images; column-major, as the caster and the shader walk
+        the image column by column."""
+        if (H, W) not in self._scratch:
+            self._scratch[(H, W)] = (np.empty((W, H), np.int32).T,
+                                     np.empty((W, H, 3)).transpose(1, 0, 2))
+        return self._scratch[(H, W)]
 
     def _image(self, pose, camera_height: float, rays, k: int, spacing: float,
                lighting: Lighting | None) -> np.ndarray:
         beta, tan_elev = rays
         x, y, yaw = (float(v) for v in pose)
         H, W = tan_elev.shape
-        hit = np.empty((H, W), np.int64)
-        weights = np.empty((H, W, 3))
+        hit, weights = self._buffers(H, W)
         origin = np.array([x, y, camera_height])
         cast_columns(self._tris, self._normals, self._closed, origin, yaw, beta, tan_elev,
                      hit, weights)
-        colors = np.empty((H, W, 3), np.float32)    # what the box average takes
+        image = np.empty((H // k, W // k, 3), np.uint8)
         light = lighting or DEFAULT_LIGHTING
         shadow = self._shadow_map(light) if self.shadows else _NO_SHADOWS
-        shade(hit, weights, self._lit_colors(light, origin), self._texture,
+        direction = np.asarray(light.direction, np.float64)
+        lit = lit_colors(self.mesh.colors, self._normals, self._tris,
+                         direction / np.linalg.norm(direction), light.ambient, light.diffuse,
+                         origin)
+        shade(hit, weights, lit, self._texture,
               self._uvs, self._atlas, self._levels, self._first_level, self._texel_density,
-              self._tris, self._normals, origin, spacing, self.sky, colors,
+              self._tris, self._normals, origin, spacing, self.sky, image,
               self.mesh.colors * light.ambient if self.shadows else self.mesh.colors,
               shadow.depth, shadow.axes, shadow.origin, shadow.cell)
-        if k > 1:   # the mean of each pixel's k x k samples (INTER_AREA: box average)
-            colors = cv2.resize(colors, (W // k, H // k), interpolation=cv2.INTER_AREA)
-        colors *= 255
-        colors += 0.5
-        return photometric(colors.astype(np.uint8), lighting)
+        return photometric(image, lighting)
 
     def panorama(self, pose, camera_height: float, config: CameraConfig,
                  lighting: Lighting | None = None, supersampling: int | None = None) -> np.ndarray:
