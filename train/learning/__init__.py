@@ -2,4 +2,4 @@
 the oracle, feature extractors, and shipping a trained policy with its record."""
 
 #: Names of the features extractors (:mod:`homing_train.learning.extractor`).
-EXTRACTORS = ("panorama", "combined")
+EXTRACTORS = ("panorama", "band", "combined")

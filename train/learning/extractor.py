@@ -8,6 +8,11 @@ or right edge, and zero padding along elevation. Other Box observations (e.g.
 ``odometry``, ``signature``) are flattened and concatenated after the convolutional trunk.
 Sized for CPU training: a 4 x 4 stride-4 patch layer, two stride-2 convolutions and
 one linear layer (about 8 M multiply-adds per 48 x 256 sample).
+
+:class:`HorizonBandExtractor` (``"band"``) is smaller still, for throughput on CPU cores:
+it treats the rows of a low panorama (a band around the horizon, e.g. 16 x 128) as
+channels and runs 1-D circular convolutions over azimuth only (about 1.5 M multiply-adds
+per 16 x 128 sample with the default layers).
 """
 
 from __future__ import annotations
@@ -38,10 +43,25 @@ class CircularConv(nn.Module):
         return F.relu(self.conv(x))
 
 
+class CircularConv1d(nn.Module):
+    """``Conv1d`` over azimuth with circular padding ``(kernel - stride + 1) // 2`` on each
+    side (the output keeps ``width / stride``), then ReLU."""
+
+    def __init__(self, c_in: int, c_out: int, kernel: int, stride: int):
+        super().__init__()
+        self.pad = max(kernel - stride + 1, 0) // 2
+        self.conv = nn.Conv1d(c_in, c_out, kernel, stride)
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        return F.relu(self.conv(F.pad(x, (self.pad, self.pad), mode="circular")))
+
+
 class PanoramaGoalExtractor(BaseFeaturesExtractor):
     """Early-fusion CNN over ``image_keys`` (default: panorama and goal) stacked as channels;
     other keys are flattened and appended. ``layers``: (channels, kernel, stride) of each
     convolution. Output: ``features_dim`` + extra values."""
+
+    conv = CircularConv
 
     def __init__(self, observation_space: gym.spaces.Dict, features_dim: int = 256,
                  image_keys: tuple[str, ...] = ("panorama", "goal"),
@@ -49,7 +69,7 @@ class PanoramaGoalExtractor(BaseFeaturesExtractor):
                                                              (64, 3, 2))):
         missing = [k for k in image_keys if k not in observation_space.spaces]
         if missing:
-            raise ValueError(f"PanoramaGoalExtractor needs observation keys {missing}; the "
+            raise ValueError(f"{type(self).__name__} needs observation keys {missing}; the "
                              f"space has {list(observation_space.spaces)}")
         for key in image_keys:
             if not is_image_space(observation_space[key], check_channels=False):
@@ -60,31 +80,57 @@ class PanoramaGoalExtractor(BaseFeaturesExtractor):
         super().__init__(observation_space, features_dim + extra_dim)
         self.image_keys = tuple(image_keys)
         self.extra_keys = tuple(extra_keys)
-        c_in = sum(observation_space[k].shape[0] for k in image_keys)   # SB3 gives CHW
-        convs = []
-        for c_out, kernel, stride in layers:
-            convs.append(CircularConv(c_in, c_out, kernel, stride))
-            c_in = c_out
-        self.cnn = nn.Sequential(*convs, nn.Flatten())
+        sample = self.fused({k: torch.zeros(1, *observation_space[k].shape) for k in image_keys})
+        self.cnn = self.trunk(sample.shape[1], layers)
         with torch.no_grad():
-            sample = torch.zeros(1, sum(observation_space[k].shape[0] for k in image_keys),
-                                 *observation_space[image_keys[0]].shape[1:])
             n_flat = self.cnn(sample).shape[1]
         self.linear = nn.Sequential(nn.Linear(n_flat, features_dim), nn.ReLU())
 
+    def fused(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
+        """The images stacked as channels: ``(N, sum C, H, W)`` (SB3 gives CHW)."""
+        return torch.cat([observations[k] for k in self.image_keys], dim=1)
+
+    def trunk(self, c_in: int, layers: tuple[tuple[int, int, int], ...]) -> nn.Sequential:
+        """The convolutions (:attr:`conv`, circular along azimuth), then a flatten."""
+        convs = []
+        for c_out, kernel, stride in layers:
+            convs.append(self.conv(c_in, c_out, kernel, stride))
+            c_in = c_out
+        return nn.Sequential(*convs, nn.Flatten())
+
     def forward(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
-        images = torch.cat([observations[k] for k in self.image_keys], dim=1)
-        features = [self.linear(self.cnn(images))]
+        features = [self.linear(self.cnn(self.fused(observations)))]
         features += [observations[k].flatten(1) for k in self.extra_keys]
         return torch.cat(features, dim=1)
 
 
+class HorizonBandExtractor(PanoramaGoalExtractor):
+    """:class:`PanoramaGoalExtractor` with every row of every image as a channel of a 1-D
+    signal over azimuth: ``(C, H, W)`` images give ``sum(C * H)`` channels of width
+    ``W``, and ``layers`` are (channels, kernel, stride) of 1-D circular convolutions.
+    Meant for low panoramas (a band around the horizon): only the first layer's cost
+    grows with ``H``."""
+
+    conv = CircularConv1d
+
+    def __init__(self, observation_space: gym.spaces.Dict, features_dim: int = 128,
+                 image_keys: tuple[str, ...] = ("panorama", "goal"),
+                 layers: tuple[tuple[int, int, int], ...] = ((32, 5, 2), (64, 5, 2),
+                                                             (64, 3, 2))):
+        super().__init__(observation_space, features_dim, image_keys, layers)
+
+    def fused(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
+        """The images' rows stacked as channels: ``(N, sum C * H, W)``."""
+        return torch.cat([observations[k].flatten(1, 2) for k in self.image_keys], dim=1)
+
+
 def policy_kwargs_for(extractor: str, **extractor_kwargs) -> dict:
     """``policy_kwargs`` for ``PPO("MultiInputPolicy", ...)``: ``"panorama"`` uses
-    :class:`PanoramaGoalExtractor`, ``"combined"`` SB3's default ``CombinedExtractor``."""
+    :class:`PanoramaGoalExtractor`, ``"band"`` :class:`HorizonBandExtractor`,
+    ``"combined"`` SB3's default ``CombinedExtractor``."""
     if extractor not in EXTRACTORS:
         raise ValueError(f"unknown extractor {extractor!r}; allowed: {EXTRACTORS}")
     if extractor == "combined":
         return {}
-    return {"features_extractor_class": PanoramaGoalExtractor,
-            "features_extractor_kwargs": extractor_kwargs}
+    cls = HorizonBandExtractor if extractor == "band" else PanoramaGoalExtractor
+    return {"features_extractor_class": cls, "features_extractor_kwargs": extractor_kwargs}

@@ -108,6 +108,28 @@ class TrainConfig:
             raise ValueError(f"eval_deterministic must be true or false, got "
                              f"{self.eval_deterministic!r}")
         check_ppo(self.ppo, self.n_envs)
+        scenes = self.env_kwargs.get("scene")
+        if isinstance(scenes, list):
+            if not scenes or not all(isinstance(name, str) for name in scenes):
+                raise ValueError(f"env_kwargs scene: a scene name or a non-empty list of "
+                                 f"scene names, got {scenes!r}")
+            if self.pretrain_samples or self.imitation_iterations:
+                raise ValueError("a list of scenes is for PPO's envs; pretraining and DAgger "
+                                 "take one scene (env_kwargs scene: NAME)")
+
+    def env_kwargs_of(self, rank: int) -> dict:
+        """The env kwargs of vector env ``rank``: with a list of scenes, env ``rank``
+        builds ``scene[rank % len(scene)]`` (e.g. both procedural generators at once)."""
+        scenes = self.env_kwargs.get("scene")
+        if isinstance(scenes, list):
+            return {**self.env_kwargs, "scene": scenes[rank % len(scenes)]}
+        return self.env_kwargs
+
+    @property
+    def n_scenes(self) -> int:
+        """How many scenes the envs cycle through (1 unless ``scene`` is a list)."""
+        scenes = self.env_kwargs.get("scene")
+        return len(scenes) if isinstance(scenes, list) else 1
 
 
 def load_hyperparams(env_id: str, path: Path = HYPERPARAMS) -> dict[str, Any]:
@@ -194,6 +216,14 @@ def make_env(env_id: str, env_kwargs: dict[str, Any], report_dir: str | None = N
     return env
 
 
+def make_monitored_env(env_id: str, env_kwargs: dict[str, Any],
+                       report_dir: str | None = None) -> gym.Env:
+    """:func:`make_env` in SB3's ``Monitor`` (episode returns, lengths and successes)."""
+    from stable_baselines3.common.monitor import Monitor
+
+    return Monitor(make_env(env_id, env_kwargs, report_dir), info_keywords=("is_success",))
+
+
 def worker_error(report_dir: Path) -> EnvWorkerError | None:
     """The first error a worker wrote to ``report_dir`` (its one-line summary as the
     message, the traceback in ``details``), or ``None``."""
@@ -207,19 +237,18 @@ def worker_error(report_dir: Path) -> EnvWorkerError | None:
 
 
 def make_vec(config: TrainConfig, n_envs: int, seed: int, report_dir: Path | None = None):
-    """A monitored vector env of ``n_envs`` copies (success logged from ``is_success``),
-    images transposed to channel-first; subprocess workers write their errors to
-    ``report_dir``."""
-    from stable_baselines3.common.env_util import make_vec_env
+    """A monitored vector env of ``n_envs`` envs (env ``i``: :meth:`TrainConfig.env_kwargs_of`
+    ``(i)``, seed ``seed + i``; success logged from ``is_success``), images transposed to
+    channel-first; subprocess workers write their errors to ``report_dir``."""
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecTransposeImage
 
-    vec_cls, vec_kwargs = DummyVecEnv, None
+    vec_cls, vec_kwargs = DummyVecEnv, {}
     if config.vec == "subproc" and n_envs > 1:
         vec_cls, vec_kwargs = SubprocVecEnv, {"start_method": "spawn"}
-    env = make_vec_env(partial(make_env, config.env_id, config.env_kwargs,
-                               None if report_dir is None else str(report_dir)),
-                       n_envs=n_envs, seed=seed, vec_env_cls=vec_cls, vec_env_kwargs=vec_kwargs,
-                       monitor_kwargs={"info_keywords": ("is_success",)})
+    report = None if report_dir is None else str(report_dir)
+    env = vec_cls([partial(make_monitored_env, config.env_id, config.env_kwargs_of(rank), report)
+                   for rank in range(n_envs)], **vec_kwargs)
+    env.seed(seed)
     return VecTransposeImage(env)      # channel-first images, as SB3 would wrap them itself
 
 
@@ -360,7 +389,7 @@ def new_model(config: TrainConfig, env, **kwargs):
     from homing_train.learning.extractor import policy_kwargs_for
 
     extractor_kwargs = ({"features_dim": config.features_dim}
-                        if config.extractor == "panorama" else {})
+                        if config.extractor != "combined" else {})
     if config.ppo.get("use_sde") and not isinstance(env.action_space, gym.spaces.Box):
         raise ValueError(f"use_sde needs continuous actions (action_type='continuous'); "
                          f"this env's action space is {env.action_space}")
@@ -384,7 +413,7 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
     torch.set_num_threads(config.torch_threads)
     # a bad env setting fails here, once, with its own message, before the run folder is
     # written (in a subprocess worker it would surface as a broken pipe)
-    probe = make_env(config.env_id, config.env_kwargs)
+    probe = make_env(config.env_id, config.env_kwargs_of(0))
     # the renderer and physics in effect are recorded, so that the policy is evaluated
     # with them (homing_train.learning.ship) even after a default changes
     made = probe.unwrapped
@@ -402,7 +431,7 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
     done_steps = checkpoint_steps(checkpoint) if checkpoint is not None else 0
     report_dir = Path(tempfile.mkdtemp(prefix="homing-train-workers-"))
     env = make_vec(config, config.n_envs, config.seed + done_steps, report_dir)
-    eval_env = make_vec(TrainConfig(**{**asdict(config), "vec": "dummy"}), 1,
+    eval_env = make_vec(TrainConfig(**{**asdict(config), "vec": "dummy"}), config.n_scenes,
                         config.seed + EVAL_SEED_OFFSET)
     try:
         if checkpoint is not None:

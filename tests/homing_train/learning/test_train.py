@@ -7,7 +7,8 @@ import pytest
 import torch
 import yaml
 
-from homing_train.learning.extractor import CircularConv, PanoramaGoalExtractor
+from homing_train.learning.extractor import (CircularConv, CircularConv1d, HorizonBandExtractor,
+                                             PanoramaGoalExtractor)
 from homing_train.learning.train import latest_checkpoint, load_hyperparams, main, make_config, parse_overrides
 
 # 36 rows: the smallest height SB3's NatureCNN (inside CombinedExtractor) accepts
@@ -18,7 +19,7 @@ TINY = ["--env-kwargs", json.dumps({"panorama_shape": [36, 64], "max_episode_ste
         "--hp", "features_dim=32"]
 
 
-@pytest.mark.parametrize("extractor", ["panorama", "combined"])
+@pytest.mark.parametrize("extractor", ["panorama", "band", "combined"])
 def test_smoke_run_writes_a_complete_run_folder(tmp_path, extractor):
     run = tmp_path / extractor
     main(["--timesteps", "256", "--extractor", extractor, "--out", str(run), *TINY])
@@ -92,6 +93,35 @@ def test_circular_padding_makes_the_extractor_equivariant_to_azimuth_shifts():
     x = torch.rand(1, 3, 8, 32)
     shifted = torch.roll(x, 5, dims=3)
     assert torch.allclose(torch.roll(conv(x), 5, dims=3), conv(shifted), atol=1e-6)
+
+
+def test_1d_circular_padding_is_equivariant_to_azimuth_shifts():
+    torch.manual_seed(0)
+    conv = CircularConv1d(6, 4, kernel=5, stride=1)
+    x = torch.rand(2, 6, 32)
+    assert torch.allclose(torch.roll(conv(x), 7, dims=2), conv(torch.roll(x, 7, dims=2)),
+                          atol=1e-6)
+    assert CircularConv1d(6, 4, kernel=5, stride=2)(x).shape == (2, 4, 16)
+
+
+def test_band_extractor_takes_every_row_of_both_images_as_channels():
+    import gymnasium as gym
+
+    space = gym.spaces.Dict({
+        "panorama": gym.spaces.Box(0, 255, (3, 8, 64), np.uint8),
+        "goal": gym.spaces.Box(0, 255, (3, 8, 64), np.uint8),
+        "odometry": gym.spaces.Box(-np.inf, np.inf, (3,), np.float32)})
+    extractor = HorizonBandExtractor(space, features_dim=16)
+    assert extractor.cnn[0].conv.in_channels == 2 * 3 * 8
+    assert extractor.features_dim == 19
+    obs = {"panorama": torch.rand(2, 3, 8, 64), "goal": torch.rand(2, 3, 8, 64),
+           "odometry": torch.rand(2, 3)}
+    out = extractor(obs)
+    assert out.shape == (2, 19)
+    assert torch.equal(out[:, 16:], obs["odometry"])
+    changed = dict(obs, goal=obs["goal"].clone())
+    changed["goal"][:, :, 5] += 0.5                 # one row of the goal image
+    assert not torch.allclose(extractor(changed)[:, :16], out[:, :16])
 
 
 def test_extractor_fuses_current_and_goal_early():
@@ -328,3 +358,23 @@ def test_benchmark_measures_the_ppo_time_split_and_writes_nothing(tmp_path, caps
     assert list(tmp_path.iterdir()) == []
     with pytest.raises(SystemExit):
         main(["--benchmark", "10", "--hp", "n_steps=64"])     # less than one rollout
+
+
+def test_a_list_of_scenes_gives_each_env_its_own_and_bad_lists_are_refused():
+    from homing_train.learning.train import TrainConfig, make_vec
+
+    config = TrainConfig("homing_gym/LocalHoming-v0", n_envs=3, vec="dummy",
+                         env_kwargs={"scene": ["random_rooms", "random_nature"],
+                                     "panorama_shape": [8, 32]})
+    env = make_vec(config, 3, seed=0)
+    env.reset()
+    names = [e.unwrapped.scene.name for e in env.venv.envs]
+    env.close()
+    assert names == ["random_rooms", "random_nature", "random_rooms"]
+    assert config.env_kwargs_of(2)["scene"] == "random_rooms" and config.n_scenes == 2
+    for bad in ([], ["random_rooms", 3]):
+        with pytest.raises(ValueError, match="list of scene names"):
+            TrainConfig("homing_gym/LocalHoming-v0", env_kwargs={"scene": bad})
+    with pytest.raises(ValueError, match="pretraining and DAgger take one scene"):
+        TrainConfig("homing_gym/LocalHoming-v0", pretrain_samples=10,
+                    env_kwargs={"scene": ["random_rooms", "random_nature"]})
