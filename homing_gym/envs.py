@@ -71,8 +71,9 @@ class LocalHomingEnv(HomingEnv):
 
     ``progress * (d_prev - d)`` (potential-based, ``d`` the distance to home in metres)
     ``+ success`` once on success ``- collision`` on each step with contact
-    ``- time`` on each step; defaults 1.0, 10.0, 0.1, 0.01 (see ``RewardConfig``). Each
-    term is reported in ``info["rewards"]``.
+    ``- time`` on each step ``- wrong_stop`` on a stop outside the success radius
+    (``success_on="stop"``); defaults 1.0, 10.0, 0.1, 0.01, 0 (see ``RewardConfig``).
+    Each term is reported in ``info["rewards"]``.
 
     ## Starting state
 
@@ -173,8 +174,9 @@ class RouteFollowingEnv(HomingEnv):
 
     ``progress * (d_prev - d)`` towards the current target (restarted at each switch)
     ``+ waypoint`` for each intermediate target reached within the radius ``+ success``
-    for the last one ``- collision`` on each step with contact ``- time`` on each step;
-    defaults 1.0, 1.0, 10.0, 0.1, 0.01. Terms in ``info["rewards"]``.
+    for the last one ``- collision`` on each step with contact ``- time`` on each step
+    ``- wrong_stop`` on a stop outside the radius (``success_on="stop"``); defaults 1.0,
+    1.0, 10.0, 0.1, 0.01, 0. Terms in ``info["rewards"]``.
 
     ## Starting state
 
@@ -267,8 +269,9 @@ class LongRangeHomingEnv(HomingEnv):
     ## Rewards
 
     0 during the outbound phase. Then as ``LocalHoming-v0``: ``progress * (d_prev - d)``
-    ``+ success`` once ``- collision`` per step with contact ``- time`` per step; defaults
-    1.0, 10.0, 0.1, 0.01. Terms in ``info["rewards"]``.
+    ``+ success`` once ``- collision`` per step with contact ``- time`` per step
+    ``- wrong_stop`` on a stop away from home (``success_on="stop"``); defaults 1.0, 10.0,
+    0.1, 0.01, 0. Terms in ``info["rewards"]``.
 
     ## Starting state
 

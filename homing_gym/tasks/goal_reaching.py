@@ -20,13 +20,17 @@ class RewardConfig:
     goal (per metre: potential-based shaping with potential ``-distance``, restarted when
     the goal changes); ``waypoint`` is paid for each intermediate goal of a route,
     ``success`` once on success; ``collision`` is subtracted on every step with contact,
-    ``time`` on every step."""
+    ``time`` on every step, ``wrong_stop`` each time the agent stops outside the success
+    radius (``success_on="stop"``; 0 by default: such a stop already forfeits the progress
+    still to be made, but an untrained policy stops at random and learns that stopping
+    anywhere ends the time penalty)."""
 
     progress: float = 1.0
     waypoint: float = 1.0
     success: float = 10.0
     collision: float = 0.1
     time: float = 0.01
+    wrong_stop: float = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -88,6 +92,7 @@ class GoalReachingTask(Task):
             "success": 0.0,
             "collision": -self.reward.collision if collision else 0.0,
             "time": -self.reward.time,
+            "wrong_stop": -self.reward.wrong_stop if arrived and not within else 0.0,
         }
         self._prev_distance = distance
         terminated = success = False

@@ -128,6 +128,7 @@ class LandmarkNavigationTask(Task):
             "success": self.reward.success if success else 0.0,
             "collision": -self.reward.collision if collision else 0.0,
             "time": -self.reward.time,
+            "wrong_stop": -self.reward.wrong_stop if terminated and not success else 0.0,
         }
         self._prev_distance = distance
         return rewards, terminated, success

@@ -149,7 +149,8 @@ class LongRangeHomingTask(GoalReachingTask):
             if self.waypoint == len(self.route):
                 self.phase = HOMING
                 self._prev_distance = ctx.distance_to_goal()
-        rewards = {k: 0.0 for k in ("progress", "waypoint", "success", "collision", "time")}
+        rewards = {k: 0.0 for k in ("progress", "waypoint", "success", "collision", "time",
+                                    "wrong_stop")}
         return rewards, False, False
 
     def observation_keys(self) -> dict[str, ObservationKey]:

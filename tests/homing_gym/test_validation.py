@@ -87,6 +87,21 @@ def test_unknown_shape_texture_and_degenerate_wall():
         Wall((0, 0), (0, 0))
 
 
+def test_a_stop_away_from_home_costs_the_wrong_stop_weight_and_ends_the_episode(make_env):
+    env = make_env(scene="arena", action_type="discrete", success_on="stop",
+                   start_distance=(1.0, 1.2), reward={"wrong_stop": 2.0, "time": 0.0},
+                   panorama_shape=(16, 64))
+    env.reset(seed=0)
+    _, reward, terminated, _, info = env.step(3)              # stop, about 1 m from home
+    assert terminated and not info["is_success"]
+    assert info["rewards"]["wrong_stop"] == -2.0
+    assert reward == pytest.approx(sum(info["rewards"].values()))
+    default = make_env(scene="arena", action_type="discrete", success_on="stop",
+                       start_distance=(1.0, 1.2), panorama_shape=(16, 64))
+    default.reset(seed=0)
+    assert default.step(3)[4]["rewards"]["wrong_stop"] == 0.0
+
+
 def test_reward_weights_from_a_mapping_scale_the_progress_term(make_env):
     env = make_env(reward={"progress": 10.0, "time": 0.0})
     env.reset(seed=0)
