@@ -22,7 +22,10 @@ class MeshPart:
     ``face_colors`` ``(F, 3)`` RGB in ``[0, 1]``; optionally ``uvs`` ``(V, 2)`` (u left
     to right, v bottom to top) and ``texture`` (uint8 ``(H, W, 3)``, row 0 at the top),
     which the ray caster uses instead of the face colours. ``collision``: the robot
-    bumps into it. Parts compare by identity (their arrays are not hashed)."""
+    bumps into it. ``solid_faces``: the face indices of each closed solid wound outwards,
+    where the part's maker knows them (a generator that built them so); ``None``: found
+    with trimesh (:attr:`solids`). Parts compare by identity (their arrays are not
+    hashed)."""
 
     vertices: np.ndarray
     faces: np.ndarray
@@ -31,6 +34,7 @@ class MeshPart:
     texture: np.ndarray | None = None
     collision: bool = True
     name: str = "mesh"
+    solid_faces: tuple[np.ndarray, ...] | None = None
 
     def __post_init__(self) -> None:
         owner = f"mesh part {self.name!r}"
@@ -64,6 +68,13 @@ class MeshPart:
                                  f"{texture.dtype} {texture.shape}")
             object.__setattr__(self, "uvs", uvs)
             object.__setattr__(self, "texture", texture)
+        if self.solid_faces is not None:
+            solids = tuple(np.sort(np.asarray(f, np.int64)) for f in self.solid_faces)
+            if any(f.ndim != 1 or len(f) == 0 or f[0] < 0 or f[-1] >= len(faces)
+                   for f in solids):
+                raise ValueError(f"{owner}: solid_faces must be non-empty lists of face "
+                                 f"indices in [0, {len(faces) - 1}]")
+            object.__setattr__(self, "solid_faces", solids)
         object.__setattr__(self, "vertices", vertices)
         object.__setattr__(self, "faces", faces.astype(np.int64))
         object.__setattr__(self, "face_colors", colors)
@@ -77,7 +88,10 @@ class MeshPart:
     def solids(self) -> list[np.ndarray]:
         """Face indices of each closed solid in the part: a connected component that is
         watertight and wound outwards (``trimesh`` ``is_volume``; a room's inward-wound
-        shell and open surfaces are not). Computed once per part."""
+        shell and open surfaces are not). Computed once per part, unless the part's
+        maker gave them (``solid_faces``)."""
+        if self.solid_faces is not None:
+            return list(self.solid_faces)
         import trimesh     # only mesh worlds need it
 
         mesh = trimesh.Trimesh(self.vertices, self.faces, process=False)

@@ -34,13 +34,15 @@ GAP = 0.4
 
 def _part(meshes: list[trimesh.Trimesh], colors: list[np.ndarray], name: str,
           collision: bool) -> MeshPart:
-    """One part of several meshes, each face in its mesh's colour (``colors``: one RGB per
-    mesh, or one per face)."""
+    """One part of several closed solids (each mesh one solid, wound outwards), each face
+    in its mesh's colour (``colors``: one RGB per mesh, or one per face)."""
     joined = trimesh.util.concatenate(meshes)
     face_colors = np.concatenate([np.broadcast_to(c, (len(m.faces), 3))
                                   for m, c in zip(meshes, colors)])
+    ends = np.cumsum([len(m.faces) for m in meshes])
+    solids = tuple(np.arange(end - len(m.faces), end) for m, end in zip(meshes, ends))
     return MeshPart(joined.vertices, joined.faces, np.clip(face_colors, 0, 1),
-                    collision=collision, name=name)
+                    collision=collision, name=name, solid_faces=solids)
 
 
 def _lump(rng: np.random.Generator, centre, size) -> trimesh.Trimesh:
@@ -86,7 +88,7 @@ def _ground(rng: np.random.Generator) -> MeshPart:
     colors = base * rng.uniform(0.75, 1.25, (len(faces), 1)) + rng.uniform(-0.05, 0.05,
                                                                            (len(faces), 3))
     return MeshPart(vertices, np.array(faces), np.clip(colors, 0, 1), collision=False,
-                    name="ground")
+                    name="ground", solid_faces=())           # an open surface
 
 
 def _hills(rng: np.random.Generator) -> MeshPart:
@@ -109,7 +111,7 @@ def _hills(rng: np.random.Generator) -> MeshPart:
     tint = np.array([rng.uniform(0.3, 0.45), rng.uniform(0.4, 0.55), rng.uniform(0.45, 0.6)])
     colors = tint * rng.uniform(0.85, 1.15, (len(faces), 1))
     return MeshPart(vertices, np.array(faces), np.clip(colors, 0, 1), collision=False,
-                    name="hills")
+                    name="hills", solid_faces=())            # an open band
 
 
 def random_nature_scene(rng: np.random.Generator) -> Scene:

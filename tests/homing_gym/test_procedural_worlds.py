@@ -96,3 +96,26 @@ def test_oracle_homes_in_procedural_worlds(name, renderer, make_env, controller_
         result = rollout(env, oracle, seed=seed)
         assert result.info["is_success"], (seed, result.info["distance_to_goal"])
         assert math.dist(result.info["pose"][:2], result.info["home_pose"][:2]) < 0.15
+
+
+def test_the_nature_generator_declares_the_solids_trimesh_would_find():
+    """random_nature gives each part's closed solids (MeshPart.solid_faces) instead of
+    letting trimesh search for them on every reset: the same face sets."""
+    from homing_gym.scenes import scene_factory
+    from homing_gym.scenes.mesh_part import MeshPart
+
+    for seed in range(3):
+        for part in scene_factory("random_nature").build(np.random.default_rng(seed)).meshes:
+            found = MeshPart(part.vertices, part.faces, part.face_colors, name=part.name).solids
+            assert (sorted(tuple(f) for f in part.solids)
+                    == sorted(tuple(f) for f in found)), (seed, part.name)
+
+
+def test_solid_faces_out_of_range_are_refused():
+    from homing_gym.scenes.mesh_part import MeshPart
+
+    tri = dict(vertices=np.eye(3), faces=[[0, 1, 2]], face_colors=[[1.0, 0.0, 0.0]])
+    with pytest.raises(ValueError, match="solid_faces"):
+        MeshPart(**tri, solid_faces=([0, 1],))
+    with pytest.raises(ValueError, match="solid_faces"):
+        MeshPart(**tri, solid_faces=([],))
