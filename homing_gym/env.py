@@ -88,7 +88,8 @@ class HomingEnv(gym.Env):
                  odometry_noise: float = 0.02, odometry_origin: str = "start",
                  lighting_change: float = 0.0, goal_step_length: float = 0.15,
                  camera_height: float = RobotConfig.camera_height, drive: str = "differential",
-                 sky_color: tuple[float, float, float] | None = None, shadows: bool = False):
+                 sky_color: tuple[float, float, float] | None = None, shadows: bool = False,
+                 episodes_per_world: int = 1):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"unknown render_mode {render_mode!r}; allowed: "
                              f"{self.metadata['render_modes']} or None")
@@ -121,6 +122,9 @@ class HomingEnv(gym.Env):
             raise ValueError(f"lighting_change must be in [0, 1] (0: off), got {lighting_change!r}")
         if not (0 <= stop_threshold < 1):
             raise ValueError(f"stop_threshold must be in [0, 1), got {stop_threshold!r}")
+        if not (isinstance(episodes_per_world, (int, np.integer)) and episodes_per_world >= 1):
+            raise ValueError(f"episodes_per_world must be an integer >= 1, got "
+                             f"{episodes_per_world!r}")
         table: dict[str, ObservationKey] = {**CORE_KEYS,
                                             "goal_step": goal_step_key(goal_step_length),
                                             **task.observation_keys()}
@@ -137,6 +141,8 @@ class HomingEnv(gym.Env):
         self.physics_substeps = int(physics_substeps)
         self.stop_threshold = float(stop_threshold)
         self.lighting_change = float(lighting_change)
+        self.episodes_per_world = int(episodes_per_world)
+        self._world_episodes_left = 0
         self.goal_step_length = float(goal_step_length)
         self._lighting: Lighting | None = None
         if not (isinstance(camera_height, (int, float)) and 0.005 <= camera_height <= 5.0):
@@ -376,8 +382,13 @@ class HomingEnv(gym.Env):
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         self._check_open()
         super().reset(seed=seed)
-        if self._scene_factory.randomised:
+        # a randomised scene draws a new world on a seeded reset and every
+        # episodes_per_world unseeded ones (building a procedural world costs tens of ms)
+        if self._scene_factory.randomised and (seed is not None
+                                               or self._world_episodes_left <= 0):
             self.scene = self._scene_factory.build(self.np_random)
+            self._world_episodes_left = self.episodes_per_world
+        self._world_episodes_left -= 1
         self.sim.reset_world(self.scene)
         self.episode = self._episode_with_options(
             self.task.sample_episode(self.scene, self.np_random), options or {})

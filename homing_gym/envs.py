@@ -127,6 +127,9 @@ class LocalHomingEnv(HomingEnv):
     ``sky_color`` (RGB in [0, 1] of rays that hit nothing; ``renderer="raycast"`` only),
     ``shadows`` = False (``renderer="raycast"`` only: objects cast shadows from the scene
     light, which moves with ``lighting_change``; see :mod:`homing_gym.shadows`),
+    ``episodes_per_world`` = 1 (a randomised scene draws a new world on every seeded reset
+    and on every ``episodes_per_world``-th unseeded one: for training, where building a
+    procedural world, 30-70 ms, would dominate short episodes),
     ``start_distance`` (its minimum at least ``success_radius``), ``success_radius``,
     ``success_on``, ``reward`` (a
     ``RewardConfig``, or a dict of some of its fields, e.g. ``{"progress": 10.0}``),

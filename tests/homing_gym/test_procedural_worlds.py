@@ -119,3 +119,21 @@ def test_solid_faces_out_of_range_are_refused():
         MeshPart(**tri, solid_faces=([0, 1],))
     with pytest.raises(ValueError, match="solid_faces"):
         MeshPart(**tri, solid_faces=([],))
+
+
+def test_episodes_per_world_keeps_a_world_for_that_many_unseeded_resets(make_env):
+    env = make_env(scene="random_rooms", episodes_per_world=3, panorama_shape=(8, 32))
+    env.reset(seed=5)
+    worlds = [env.unwrapped.scene]
+    homes = [env.unwrapped.episode.goals[-1]]
+    for _ in range(5):
+        env.reset()
+        worlds.append(env.unwrapped.scene)
+        homes.append(env.unwrapped.episode.goals[-1])
+    assert worlds[0] is worlds[1] is worlds[2]
+    assert worlds[3] is worlds[4] is worlds[5] and worlds[3] != worlds[0]
+    assert len({tuple(np.round(h, 6)) for h in homes[:3]}) == 3    # new episodes in it
+    env.reset(seed=5)                                    # a seeded reset: the seed's world
+    assert _signature(env.unwrapped.scene) == _signature(worlds[0])
+    with pytest.raises(ValueError, match="episodes_per_world"):
+        make_env(scene="random_rooms", episodes_per_world=0)
