@@ -60,7 +60,8 @@ def test_a_mistracked_feature_is_left_out_of_the_law():
     controller.reset()
     ids = np.arange(40)
     controller.memory = [MemoryFrame(ids, columns((0.0, 0.0)), np.zeros((1, 1), np.uint8))]
-    controller.milestones, controller.leg_ids = [0], ids
+    controller.milestones = [0]
+    controller._begin_leg(0, 0)
     now = columns((0.1, 0.0))                                  # 10 cm from the milestone
     now[:4, 0] = (now[:4, 0] + 20) % width                    # 4 tracks 28 degrees off
     controller.tracker.ids, controller.tracker.points = ids, now
@@ -69,6 +70,34 @@ def test_a_mistracked_feature_is_left_out_of_the_law():
     assert not np.isin(np.arange(4), controller._law_ids).any()
     assert len(controller._law_ids) >= 30
     assert abs(wrap_angle(move.direction - np.pi)) < 0.2       # towards the milestone
+
+
+@pytest.mark.parametrize("stall_decisions, arrives", [(5, True), (10_000, False)])
+def test_drifted_tracks_are_registered_afresh_when_the_residual_stalls(stall_decisions,
+                                                                        arrives):
+    """The robot stands at home with its tracks drifted by 1.5 columns (median residual
+    about 0.04 rad, above ``stop_tol``): the tracks never say it has arrived. After
+    ``stall_decisions`` decisions without a smaller residual it registers the home frame's
+    features from their stored image, which puts them back, and arrives."""
+    rng = np.random.default_rng(3)
+    small = rng.integers(0, 256, (12, 64, 3), dtype=np.uint8)
+    panorama = np.kron(small, np.ones((4, 4, 1), np.uint8))     # 48 x 256 blocks
+    controller = homing_baselines.make("bearing-longrange", stall_decisions=stall_decisions)
+    controller.reset()
+    controller.tracker.update(panorama)
+    ids, points = controller.tracker.ids.copy(), controller.tracker.points.copy()
+    controller.memory = [MemoryFrame(ids, points, controller.tracker.image)]
+    controller.milestones = [0]
+    controller._begin_leg(0, 0)
+    drift = rng.choice([-1.5, 1.5], len(ids)) * (rng.random(len(ids)) < 0.8)
+    controller.tracker.points = points + np.stack([drift, np.zeros(len(ids))], 1)
+    moves = [controller.decide({}) for _ in range(stall_decisions + 1 if arrives else 20)]
+    assert all(m.distance > 0 for m in moves[:stall_decisions])   # not arrived before
+    assert controller._home is arrives
+    if arrives:
+        assert moves[-1].distance == 0 and abs(moves[-1].direction) < 0.01   # phi = 0
+        err = np.abs(wrap_angle(controller.tracker.bearings() - controller._bearings()[2]))
+        assert np.median(err) < 0.01
 
 
 @pytest.mark.slow
@@ -93,6 +122,7 @@ def test_longrange_homes_from_pixels_and_turns_to_the_home_heading(make_env, con
     ({"min_shared": 20, "klt": KLTConfig(max_features=10)}, "min_shared"),
     ({"inlier_fraction": 0.0}, "inlier_fraction"),
     ({"outlier_factor": 0.5}, "outlier_factor"),
+    ({"stall_decisions": 0}, "stall_decisions"),
     ({"klt": {"max_features": 100}}, "KLTConfig"),
     ({"stop_tol": -1.0}, "stop_tol"),
 ])
