@@ -191,8 +191,8 @@ class Protocol:
 
 def episodes_key(protocol: Protocol, setting: Setting) -> tuple:
     """Equal for two settings, of one protocol or two, that run the same episodes: the
-    same env id and env kwargs, the same episode draw and the same seed (``unseen``'s
-    hallway, lab and house are ``local-common``'s)."""
+    same env id and env kwargs, the same episode draw and the same seed (``unseen`` v2's
+    hallway, lab and house were ``local-common``'s)."""
     return (setting.env_id, json.dumps(setting.kwargs(), sort_keys=True), setting.tasks,
             protocol.seed)
 
@@ -225,7 +225,8 @@ PROCEDURAL = ("random_arena", "random_rooms", "random_nature")
 
 
 def _held_out(episodes: int, seed: int) -> list[Task]:
-    """Seeds from :data:`UNSEEN_SEED` on: procedural worlds no policy trained on."""
+    """Seeds from :data:`UNSEEN_SEED` on: procedural worlds no policy trained on, and
+    homes and starts that no other protocol draws."""
     return [(UNSEEN_SEED + seed + i, None, None) for i in range(episodes)]
 
 PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
@@ -339,13 +340,13 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
               for scene in COMMON_SCENES),
         HOMING_METHODS, episodes=5),
     Protocol(
-        "unseen", 2, "worlds no shipped policy was trained on: held-out procedural worlds "
-        f"(random_arena, random_rooms, random_nature; seeds from {UNSEEN_SEED}), hallway, lab "
-        "and house; ray cast, 1/120 s physics (v1: random_arena only, TinyRenderer)",
-        (*(Setting(f"{scene} (held out)", LOCAL, {"scene": scene}, _held_out, V2_SIMULATION)
-           for scene in PROCEDURAL),
-         *(Setting(scene, LOCAL, {"scene": scene}, simulation=V2_SIMULATION)
-           for scene in ("hallway", "lab", "house"))),
+        "unseen", 3, "worlds no shipped policy was trained on: held-out procedural worlds "
+        f"(random_arena, random_rooms, random_nature) and the hallway, lab and house, all "
+        f"with seeds from {UNSEEN_SEED} (homes and starts unlike local-common's); ray cast, "
+        "1/120 s physics (v2: the hallway, lab and house ran local-common's episodes; v1: "
+        "random_arena only, TinyRenderer)",
+        tuple(Setting(f"{scene} (held out)", LOCAL, {"scene": scene}, _held_out, V2_SIMULATION)
+              for scene in (*PROCEDURAL, "hallway", "lab", "house")),
         HOMING_METHODS, episodes=5),
 )}
 

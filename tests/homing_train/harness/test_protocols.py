@@ -70,22 +70,24 @@ def test_a_policy_keeps_its_own_renderer_and_physics():
 
 
 def test_protocols_pin_their_renderer_and_physics():
-    """Version 1 was measured with TinyRenderer and 1/240 s, version 2 ray casts at
+    """Version 1 was measured with TinyRenderer and 1/240 s, later versions ray cast at
     1/120 s; both are explicit, so a change of the env defaults changes no cell."""
-    expected = {1: ("tiny", 24), 2: ("raycast", 12)}
     for p in PROTOCOLS.values():
         for setting in p.settings:
             kwargs = setting.kwargs()
-            assert (kwargs["renderer"], kwargs["physics_substeps"]) == expected[p.version]
+            expected = ("tiny", 24) if p.version == 1 else ("raycast", 12)
+            assert (kwargs["renderer"], kwargs["physics_substeps"]) == expected
 
 
 def test_unseen_worlds_are_held_out_seeds_of_every_procedural_world():
     unseen = protocol("unseen")
     scenes = [s.env_kwargs["scene"] for s in unseen.settings]
     assert {"random_arena", "random_rooms", "random_nature"} <= set(scenes)
-    for setting in unseen.settings:
-        if setting.env_kwargs["scene"].startswith("random"):
-            assert all(seed >= 10_000_000 for seed, _, _ in setting.episode_tasks(5, 0))
+    common = {seed for s in protocol("local-common").settings
+              for seed, _, _ in s.episode_tasks(5, 0)}
+    for setting in unseen.settings:            # every world's episodes its own (v3)
+        seeds = [seed for seed, _, _ in setting.episode_tasks(5, 0)]
+        assert all(seed >= 10_000_000 for seed in seeds) and not common & set(seeds)
 
 
 def test_policies_expand_to_the_shipped_policies_of_the_protocols_env():
@@ -277,17 +279,22 @@ def test_aggregate_over_two_protocols_from_their_counts():
     assert small.mean_ci[0] < big.mean_ci[0] < 0.5 < big.mean_ci[1] < small.mean_ci[1]
 
 
-def test_a_setting_two_protocols_share_counts_once_in_the_aggregate():
+def test_a_setting_two_protocols_share_counts_once_in_the_aggregate(monkeypatch):
+    """unseen v2 repeated local-common's hallway, lab and house episodes: such shared
+    settings count once; v3 draws its own, so every world counts."""
+    import dataclasses
+
+    from homing_train.harness import matrix
     from homing_train.harness.matrix import strata_counts
-    from homing_train.harness.protocols import episodes_key
 
     common, unseen = protocol("local-common"), protocol("unseen")
-    keys = {s.label: episodes_key(common, s) for s in common.settings}
-    shared = [s.label for s in unseen.settings if episodes_key(unseen, s) in keys.values()]
-    assert shared == ["hallway", "lab", "house"]             # the same seeds, the same kwargs
     cells = [_cell("local-common", "m", {s.label: (i % 6, 5) for i, s in
                                          enumerate(common.settings)}),
              _cell("unseen", "m", {s.label: (1, 5) for s in unseen.settings})]
+    assert len(strata_counts(cells)["m"]) == 12               # 6 + 6 worlds, none shared
+    shared = dataclasses.replace(unseen, settings=(*unseen.settings[:3], *common.settings[1:4]))
+    monkeypatch.setitem(matrix.PROTOCOLS, "unseen", shared)
+    cells[1] = _cell("unseen", "m", {s.label: (1, 5) for s in shared.settings})
     counts = strata_counts(cells)["m"]
     assert len(counts) == 9 and counts[:6] == [(i % 6, 5) for i in range(6)]
     assert counts[6:] == [(1, 5)] * 3                        # the held-out procedural worlds
