@@ -307,6 +307,13 @@ class HomingEnv(gym.Env):
     def _command(self, action) -> tuple[float, float, bool]:
         """Validated action -> (forward, yaw) in normalised units and the stop flag.
         Real numbers only: booleans, complex numbers, strings and ``None`` are refused."""
+        if (self.action_type != "discrete" and type(action) is np.ndarray
+                and action.shape == (2,) and action.dtype.kind == "f"):   # the usual case, fast
+            v, w = float(action[0]), float(action[1])
+            if not (math.isfinite(v) and math.isfinite(w)):
+                raise ValueError(f"action {action!r} contains NaN or infinity")
+            v, w = min(max(v, -1.0), 1.0), min(max(w, -1.0), 1.0)
+            return v, w, abs(v) < self.stop_threshold and abs(w) < self.stop_threshold
         a = np.asarray(action, dtype=object if action is None else None)
         mixed_bools = isinstance(action, (list, tuple)) and any(
             isinstance(x, (bool, np.bool_)) for x in action)
