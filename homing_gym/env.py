@@ -188,7 +188,8 @@ class HomingEnv(gym.Env):
                              sky_color=sky_color, shadows=bool(shadows))
         self.camera = PanoramaCamera(
             camera_config, self.robot_config.camera_height, renderer=self.sim.renderer,
-            caster=(lambda: self.sim.caster) if self.sim.caster is not None else None)
+            caster=(lambda: self.sim.caster) if self.sim.caster is not None else None,
+            vertices=self.sim.world_vertices if self.sim.caster is None else None)
 
         self._table = {k: table[k] for k in self.obs_keys}
         self.observation_space = spaces.Dict(

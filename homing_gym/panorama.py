@@ -240,16 +240,42 @@ def signature_weights(height: int, rows: int) -> np.ndarray:
     return (weights / rows).astype(np.float32)
 
 
+#: Corners closer than this (metres) to the plane through a perspective view's eye,
+#: perpendicular to its direction, make TinyRenderer hang (their ``w`` is 0 in float32).
+DEGENERATE_DEPTH = 1e-6
+#: How far (metres) :func:`safe_eye` moves such an eye back along its view.
+EYE_SHIFT = 1e-4
+
+
+def safe_eye(eye: tuple[float, float, float], direction: tuple[float, float],
+             vertices: np.ndarray | None) -> tuple[float, float]:
+    """The ``(x, y)`` of a perspective view's eye, moved :data:`EYE_SHIFT` back along the
+    horizontal view ``direction`` (unit) when a world corner lies in the plane through the
+    eye perpendicular to it. There PyBullet's TinyRenderer never returns (found at the
+    house's grid pose (6.2, 1.1) looking along -y, where a wall's end face lies in that
+    plane: its corners project with ``w = 0``); 0.1 mm changes nothing visible, and every
+    other view keeps its exact eye."""
+    if vertices is not None and len(vertices):
+        depth = ((vertices[:, 0] - eye[0]) * direction[0]
+                 + (vertices[:, 1] - eye[1]) * direction[1])
+        if np.any(np.abs(depth) < DEGENERATE_DEPTH):
+            return eye[0] - EYE_SHIFT * direction[0], eye[1] - EYE_SHIFT * direction[1]
+    return eye[0], eye[1]
+
+
 class PanoramaCamera:
     """Renders panoramas at a robot pose and derives the ``omni`` and ``signature`` views."""
 
     def __init__(self, config: CameraConfig = CameraConfig(), camera_height: float = 0.30,
-                 renderer: int = p.ER_TINY_RENDERER, caster=None):
+                 renderer: int = p.ER_TINY_RENDERER, caster=None, vertices=None):
         """``renderer``: PyBullet's renderer for the perspective views; ``caster``: a
         callable returning the simulator's current
-        :class:`~homing_gym.raycast.RayCaster`, which then renders instead."""
+        :class:`~homing_gym.raycast.RayCaster`, which then renders instead; ``vertices``:
+        a callable returning the world's triangle corners ``(V, 3)``, so that PyBullet's
+        views avoid the poses at which TinyRenderer never returns (:func:`safe_eye`)."""
         self.config = config
         self.caster = caster
+        self.vertices = vertices
         self.camera_height = camera_height
         self.renderer = renderer
         self.geometry = view_geometry(config)
@@ -272,11 +298,13 @@ class PanoramaCamera:
         """The ``n_views`` perspective images side by side, uint8 ``(h, n*w, 3)``."""
         g = self.geometry
         x, y, yaw = float(pose[0]), float(pose[1]), float(pose[2])
-        eye = [x, y, self.camera_height]
+        vertices = self.vertices() if self.vertices is not None else None
         for k, view_yaw in enumerate(g.yaws):
             a = yaw + view_yaw
-            target = [x + math.cos(a), y + math.sin(a), self.camera_height]
-            view = client.computeViewMatrix(eye, target, [0, 0, 1])
+            direction = (math.cos(a), math.sin(a))
+            ex, ey = safe_eye((x, y, self.camera_height), direction, vertices)
+            target = [ex + direction[0], ey + direction[1], self.camera_height]
+            view = client.computeViewMatrix([ex, ey, self.camera_height], target, [0, 0, 1])
             _, _, rgba, _, _ = client.getCameraImage(
                 g.width, g.height, view, self._projection, renderer=self.renderer,
                 shadow=0, lightDirection=list(lighting.direction),

@@ -61,6 +61,7 @@ class Simulator:
         self.caster = (RayCaster(world_mesh(scene), self.sky(scene), shadows)
                        if renderer == "raycast" else None)
         self.time_step = time_step
+        self._vertices, self._vertices_of = np.zeros((0, 3)), None   # world_vertices' cache
         self._gui = gui
         self._robot_config = robot_config
         self._step_simulation = c.stepSimulation      # BulletClient builds a new partial on
@@ -263,6 +264,14 @@ class Simulator:
             self._make_objects(scene)
         if self.caster is not None:
             self.caster = RayCaster(world_mesh(scene), self.sky(scene), self._shadows)
+
+    def world_vertices(self) -> np.ndarray:
+        """The distinct corners ``(V, 3)`` (metres) of the current world's triangles
+        (:func:`~homing_gym.worldmesh.world_mesh`), computed once per world."""
+        if self._vertices_of is not self.scene:
+            corners = world_mesh(self.scene).triangles.reshape(-1, 3).astype(np.float64)
+            self._vertices, self._vertices_of = np.unique(corners, axis=0), self.scene
+        return self._vertices
 
     def sky(self, scene: Scene) -> tuple[float, float, float]:
         """The ray caster's sky: the env's ``sky_color``, else the scene's, else white."""

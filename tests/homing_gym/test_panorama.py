@@ -135,3 +135,33 @@ def test_signature_matches_horizon_rows(make_env):
     gray = obs["panorama"].astype(np.float64) @ np.array([0.299, 0.587, 0.114]) / 255
     expected = (0.5 * gray[21] + gray[22:26].sum(0) + 0.5 * gray[26]) / 5
     assert np.allclose(obs["signature"], expected, atol=1e-4)
+
+
+def test_safe_eye_moves_only_an_eye_whose_view_plane_holds_a_corner():
+    from homing_gym.panorama import EYE_SHIFT, safe_eye
+
+    corners = np.array([[4.45, 1.1, 0.0], [4.45, 0.0, 2.4]])       # a wall's end, y = 1.1
+    assert safe_eye((6.2, 1.1, 0.3), (0.0, -1.0), corners) == (6.2, 1.1 + EYE_SHIFT)
+    assert safe_eye((6.2, 1.2, 0.3), (0.0, -1.0), corners) == (6.2, 1.2)
+    assert safe_eye((6.2, 1.1, 0.3), (1.0, 0.0), corners) == (6.2, 1.1)
+    assert safe_eye((6.2, 1.1, 0.3), (0.0, -1.0), None) == (6.2, 1.1)
+
+
+@pytest.mark.slow
+def test_tinyrenderer_returns_where_a_wall_end_lies_in_a_views_plane():
+    """At the house's grid pose (6.2, 1.1) looking along +y, one of the six views looks
+    along -y, and the end face of the wall at x = 4.5 lies in the plane through its eye:
+    TinyRenderer never returned there. Run in a subprocess, so that a regression fails
+    after 120 s instead of hanging the test suite."""
+    import subprocess
+    import sys
+
+    code = ("import math, numpy as np, gymnasium as gym, homing_gym\n"
+            "env = gym.make('homing_gym/WorkLocations-v0', scene='house', renderer='tiny')\n"
+            "env.reset(seed=0)\n"
+            "pano = env.unwrapped.render_panorama(np.array([6.2, 1.1, math.pi / 2]))\n"
+            "print(pano.shape, int(pano.mean() > 0))\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split()[-1] == "1"
