@@ -51,16 +51,6 @@ Choices where the paper is open (also in ``docs/bearing.md``):
   applies §3's registration step against the MP's stored image before arriving (the
   paper registers at each MP; here also on the way when the tracks stall), each feature
   starting from its live track, and judges arrival on the registered features.
-* **Mistracked features are left out of the law.** The law sums ``M_ij`` over every
-  pair, so one feature whose bearing is wrong (a track that slid onto a neighbouring
-  corner, or was registered onto one in the bricks' repeated texture) enters ``N - 1``
-  pairs and, near the MP where the true ``Delta theta`` vanish, sets the direction: the
-  robot dithered 15-20 cm from an MP with random directions (seed 104). §3 estimates
-  ``phi`` with the median "for robustness" because of such tracking errors; in the same
-  spirit a feature whose residual ``|A_P(F_i) - A_P'(F_i) - phi|`` exceeds
-  ``outlier_factor`` (3) times the median residual (and ``stop_tol``) is left out of the
-  law at that decision. Far from the MP the residuals are spread by parallax and few
-  are left out; near it the consistent features agree and the outliers stand out.
 * A leg's feature set shrinks as tracks are lost; Algorithm 1 needs the same landmarks at
   every step, so its state restarts whenever the set changes. With corners all around,
   criterion 1 (goal inside their hull) decides BASIC at once, so little is lost.
@@ -139,9 +129,7 @@ def median_offset(offsets: np.ndarray) -> float:
 class LongRangeBearingController(BearingLawController):
     """Long-range homing (module docstring). Parameters: ``min_shared`` (features that
     consecutive milestones share, 3 to ``klt.max_features``), ``inlier_fraction`` (of a
-    leg's live features that must agree with ``phi`` to arrive), ``outlier_factor``
-    (features whose offset residual exceeds this many times the median residual are left
-    out of the law), ``stall_decisions`` (decisions without a new smallest median residual
+    leg's live features that must agree with ``phi`` to arrive), ``stall_decisions`` (decisions without a new smallest median residual
     after which the leg's features are registered afresh against the MP image), ``klt``
     (:class:`~homing_baselines.klt.KLTConfig`) and those of
     :class:`~homing_baselines.bearing.BearingLawController` (``stop_tol``: the arrival tolerance
@@ -149,7 +137,6 @@ class LongRangeBearingController(BearingLawController):
 
     min_shared: int = 80
     inlier_fraction: float = 0.5
-    outlier_factor: float = 3.0
     stall_decisions: int = 5
     stop_tol: float = 0.01
     klt: KLTConfig = field(default_factory=KLTConfig)
@@ -168,9 +155,6 @@ class LongRangeBearingController(BearingLawController):
                              f"got {self.min_shared!r}")
         if not 0 < self.inlier_fraction <= 1:
             raise ValueError(f"inlier_fraction must be in (0, 1], got {self.inlier_fraction!r}")
-        if not (math.isfinite(self.outlier_factor) and self.outlier_factor >= 1):
-            raise ValueError(f"outlier_factor must be finite and >= 1, got "
-                             f"{self.outlier_factor!r}")
         if not (isinstance(self.stall_decisions, (int, np.integer)) and self.stall_decisions >= 1):
             raise ValueError(f"stall_decisions must be an integer >= 1, got "
                              f"{self.stall_decisions!r}")
@@ -283,9 +267,6 @@ class LongRangeBearingController(BearingLawController):
                 return Move(float(wrap_angle(-self.phi)), 0.0)
             self._arrive()
             return self.decide(observation)
-        keep = residual <= max(self.outlier_factor * median, self.stop_tol)
-        if keep.sum() >= 3:
-            ids, current, target = ids[keep], current[keep], target[keep]
         if not np.array_equal(ids, self._law_ids):     # features lost or re-attached:
             self._law = UnifiedLaw(self.unified_config())   # Algorithm 1 starts again
             self._law_ids = ids
