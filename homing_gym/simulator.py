@@ -27,13 +27,13 @@ from pybullet_utils.bullet_client import BulletClient
 from homing_gym.native_output import native_output_captured
 from homing_gym.raycast import SKY_COLOR, RayCaster
 from homing_gym.robot import Robot, RobotConfig
-from homing_gym.scenes.base import Landmark, Scene, Wall
+from homing_gym.scenes.base import Scene
 from homing_gym.scenes.footprint import band_faces
 from homing_gym.scenes.mesh_part import MeshPart
+from homing_gym.solids import (Solid, fence_solids, floor_rectangle, floor_top, landmark_solid,
+                               wall_solid)
 from homing_gym.textures import texture_path
-from homing_gym.worldmesh import FLOOR_MARGIN, floor_top, world_mesh
-
-FENCE_THICKNESS = 0.1
+from homing_gym.worldmesh import world_mesh
 
 
 def _fixed_part(scene: Scene) -> tuple:
@@ -81,15 +81,16 @@ class Simulator:
         self._textures: dict[str, int] = {}
         self.scene = scene
         self.floor_id = self._make_floor(scene)
-        self.wall_ids = [self._make_wall(w) for w in scene.walls]
-        self.fence_ids = self._make_fence(scene) if scene.fence else []
+        self.wall_ids = [self._body(wall_solid(w)) for w in scene.walls]
+        self.fence_ids = ([self._body(s, visible=False) for s in fence_solids(scene)]
+                          if scene.fence else [])
         self.robot = Robot(c, self._robot_config)
         self._bare_state = c.saveState()
         self._make_objects(scene)
 
     def _make_objects(self, scene: Scene) -> None:
         """The landmarks and mesh parts of ``scene``; saves the state."""
-        self.landmark_ids = [self._make_landmark(lm) for lm in scene.landmarks]
+        self.landmark_ids = [self._body(landmark_solid(lm)) for lm in scene.landmarks]
         self.mesh_ids = [body for part in scene.meshes
                          for body in self._make_part(part, scene.height_band)]
         self._state = self.client.saveState()
@@ -108,18 +109,10 @@ class Simulator:
         self.client.changeVisualShape(body, -1, rgbaColor=list(color),
                                       textureUniqueId=-1 if tex is None else tex)
 
-    def _box(self, half_extents, position, yaw: float, color, texture) -> int:
-        c = self.client
-        col = c.createCollisionShape(p.GEOM_BOX, halfExtents=half_extents)
-        vis = c.createVisualShape(p.GEOM_BOX, halfExtents=half_extents, rgbaColor=list(color))
-        body = c.createMultiBody(0, col, vis, position, c.getQuaternionFromEuler([0, 0, yaw]))
-        self._paint(body, color, texture)
-        return body
-
     def _make_floor(self, scene: Scene) -> int:
-        (xmin, ymin), (xmax, ymax) = scene.bounds
-        half = [(xmax - xmin) / 2 + FLOOR_MARGIN, (ymax - ymin) / 2 + FLOOR_MARGIN, 0.05]
-        centre = [(xmin + xmax) / 2, (ymin + ymax) / 2, floor_top(scene) - 0.05]
+        x0, y0, x1, y1 = floor_rectangle(scene)
+        half = [(x1 - x0) / 2, (y1 - y0) / 2, 0.05]
+        centre = [(x0 + x1) / 2, (y0 + y1) / 2, floor_top(scene) - 0.05]
         c = self.client
         col = c.createCollisionShape(p.GEOM_PLANE)
         vis = (c.createVisualShape(p.GEOM_BOX, halfExtents=half, visualFramePosition=centre,
@@ -132,28 +125,6 @@ class Simulator:
             self._hide(body)
         c.changeDynamics(body, -1, lateralFriction=1.0)
         return body
-
-    def _make_wall(self, wall: Wall) -> int:
-        (x0, y0), (x1, y1) = wall.start, wall.end
-        half = [(wall.length + wall.thickness) / 2, wall.thickness / 2, wall.height / 2]
-        yaw = math.atan2(y1 - y0, x1 - x0)
-        return self._box(half, [(x0 + x1) / 2, (y0 + y1) / 2, wall.height / 2], yaw,
-                         wall.color, wall.texture)
-
-    def _make_fence(self, scene: Scene) -> list[int]:
-        """Four invisible walls just outside ``scene.bounds`` (1 m high, 0.1 m thick)."""
-        (xmin, ymin), (xmax, ymax) = scene.bounds
-        t, c = FENCE_THICKNESS, self.client
-        cx, cy, hx, hy = (xmin + xmax) / 2, (ymin + ymax) / 2, (xmax - xmin) / 2, (ymax - ymin) / 2
-        boxes = (((cx, ymin - t / 2), (hx + t, t / 2)), ((cx, ymax + t / 2), (hx + t, t / 2)),
-                 ((xmin - t / 2, cy), (t / 2, hy + t)), ((xmax + t / 2, cy), (t / 2, hy + t)))
-        bodies = [c.createMultiBody(0, c.createCollisionShape(p.GEOM_BOX,
-                                                              halfExtents=[*half, 0.5]),
-                                    -1, [*centre, 0.5])
-                  for centre, half in boxes]
-        for body in bodies:
-            self._hide(body)
-        return bodies
 
     def _hide(self, body: int) -> None:
         """Keep PyBullet's renderers from drawing a body that has no visual shape (they
@@ -186,56 +157,30 @@ class Simulator:
                 c.changeVisualShape(bodies[-1], -1, textureUniqueId=-1)   # no default checker
         return bodies
 
-    def _make_landmark(self, lm: Landmark) -> int:
-        position = [lm.position[0], lm.position[1], lm.base + lm.height / 2]
-        if lm.shape == "panel":
-            return self._panel(lm, position)
-        if lm.shape == "box":
-            half = [lm.extent[0] / 2, lm.extent[1] / 2, lm.height / 2]
-            return self._box(half, position, lm.yaw, lm.color, lm.texture)
-        c = self.client
-        col = c.createCollisionShape(p.GEOM_CYLINDER, radius=lm.radius, height=lm.height)
-        vis = c.createVisualShape(p.GEOM_CYLINDER, radius=lm.radius, length=lm.height,
-                                  rgbaColor=list(lm.color))
-        body = c.createMultiBody(0, col, vis, position,
-                                 c.getQuaternionFromEuler([0, 0, lm.yaw]))
-        self._paint(body, lm.color, lm.texture)
-        return body
-
-    def _panel(self, lm: Landmark, position) -> int:
-        """A box whose local +y face carries the whole texture once (u left to right as
-        seen from the front, v bottom to top); the other faces sample the texture's
-        top-left corner."""
-        c = self.client
-        hx, hy, hz = lm.extent[0] / 2, lm.extent[1] / 2, lm.height / 2
-        corner = [0.001, 0.999]
-        vertices, normals, uvs, indices = [], [], [], []
-        for axis in range(3):
-            for sign in (1.0, -1.0):
-                normal = [0.0, 0.0, 0.0]
-                normal[axis] = sign
-                # two axes spanning the face, ordered so the quad winds counter-clockwise
-                a, b = [(1, 2), (2, 0), (0, 1)][axis]
-                face = []
-                for s_a, s_b in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
-                    v = [0.0, 0.0, 0.0]
-                    v[axis] = sign
-                    v[a], v[b] = s_a * sign, s_b
-                    face.append([v[0] * hx, v[1] * hy, v[2] * hz])
-                front = axis == 1 and sign > 0
-                for v in face:
-                    vertices.append(v)
-                    normals.append(normal)
-                    uvs.append([0.5 - v[0] / (2 * hx), 0.5 + v[2] / (2 * hz)] if front
-                               else corner)
-                k = len(vertices) - 4
-                indices += [k, k + 1, k + 2, k, k + 2, k + 3]
-        vis = c.createVisualShape(p.GEOM_MESH, vertices=vertices, indices=indices,
-                                  uvs=uvs, normals=normals, rgbaColor=list(lm.color))
-        col = c.createCollisionShape(p.GEOM_BOX, halfExtents=[hx, hy, hz])
-        body = c.createMultiBody(0, col, vis, position,
-                                 c.getQuaternionFromEuler([0, 0, lm.yaw]))
-        self._paint(body, lm.color, lm.texture)
+    def _body(self, solid: Solid, visible: bool = True) -> int:
+        """A static body of ``solid``: its collision shape, and (``visible``) its painted
+        visual shape for PyBullet's renderers; an invisible one is hidden."""
+        c, half = self.client, list(solid.half)
+        if solid.shape == "cylinder":
+            col = c.createCollisionShape(p.GEOM_CYLINDER, radius=solid.radius,
+                                         height=solid.height)
+        else:
+            col = c.createCollisionShape(p.GEOM_BOX, halfExtents=half)
+        vis = -1
+        if visible and solid.shape == "cylinder":
+            vis = c.createVisualShape(p.GEOM_CYLINDER, radius=solid.radius,
+                                      length=solid.height, rgbaColor=list(solid.color))
+        elif visible and solid.shape == "panel":
+            vis = c.createVisualShape(p.GEOM_MESH, **_panel_mesh(solid.half),
+                                      rgbaColor=list(solid.color))
+        elif visible:
+            vis = c.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=list(solid.color))
+        body = c.createMultiBody(0, col, vis, list(solid.centre),
+                                 c.getQuaternionFromEuler([0, 0, solid.yaw]))
+        if visible:
+            self._paint(body, solid.color, solid.texture)
+        else:
+            self._hide(body)
         return body
 
     # -- episodes -------------------------------------------------------------------------
@@ -318,6 +263,36 @@ class Simulator:
     @property
     def connected(self) -> bool:
         return self._connected
+
+
+def _panel_mesh(half) -> dict[str, list]:
+    """``createVisualShape`` arguments of a panel's box of half extents ``half``
+    (metres): its local +y face carries the whole texture once (u left to right as seen
+    from the front, v bottom to top); the other faces sample the texture's top-left
+    corner."""
+    hx, hy, hz = half
+    corner = [0.001, 0.999]
+    vertices, normals, uvs, indices = [], [], [], []
+    for axis in range(3):
+        for sign in (1.0, -1.0):
+            normal = [0.0, 0.0, 0.0]
+            normal[axis] = sign
+            # two axes spanning the face, ordered so the quad winds counter-clockwise
+            a, b = [(1, 2), (2, 0), (0, 1)][axis]
+            face = []
+            for s_a, s_b in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
+                v = [0.0, 0.0, 0.0]
+                v[axis] = sign
+                v[a], v[b] = s_a * sign, s_b
+                face.append([v[0] * hx, v[1] * hy, v[2] * hz])
+            front = axis == 1 and sign > 0
+            for v in face:
+                vertices.append(v)
+                normals.append(normal)
+                uvs.append([0.5 - v[0] / (2 * hx), 0.5 + v[2] / (2 * hz)] if front else corner)
+            k = len(vertices) - 4
+            indices += [k, k + 1, k + 2, k, k + 2, k + 3]
+    return {"vertices": vertices, "indices": indices, "uvs": uvs, "normals": normals}
 
 
 def gui_unavailable() -> str | None:

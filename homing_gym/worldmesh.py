@@ -1,18 +1,17 @@
 """A scene as one set of textured triangles: what the ray-cast renderer sees.
 
-:func:`world_mesh` turns a :class:`~homing_gym.scenes.base.Scene` into triangles with the
-same placement as the PyBullet bodies of :class:`~homing_gym.simulator.Simulator` (floor
-top face, walls and box landmarks as boxes, cylinders as 64-sided prisms, panels as boxes
-whose front face carries the texture once, mesh parts as they are; a textured part's
-texture repeats outside ``[0, 1]`` uv). Each triangle has a colour (RGB in
-``[0, 1]``), a texture index (``-1``: none) and texture coordinates per corner: ``u``
-left to right, ``v`` bottom to top, each box side and the floor covered by its texture
-once, a cylinder's side wrapped once around. The texture colour is multiplied by the
-body colour, as PyBullet does. The triangles of closed solids (boxes, prisms) are wound
-counter-clockwise seen from outside and marked ``closed``, as are the faces of a mesh
-part's closed solids (:attr:`~homing_gym.scenes.mesh_part.MeshPart.solids`): from outside
-a solid, its faces turned away are hidden behind its other faces, so the renderer skips
-them.
+:func:`world_mesh` turns a :class:`~homing_gym.scenes.base.Scene` into triangles: the top
+face of its floor and the sides of its :mod:`~homing_gym.solids` (the description the
+PyBullet bodies are built from too: boxes as boxes, cylinders as 64-sided prisms), then its
+mesh parts as they are; a textured part's texture repeats outside ``[0, 1]`` uv. Each
+triangle has a colour (RGB in ``[0, 1]``), a texture index (``-1``: none) and texture
+coordinates per corner: ``u`` left to right, ``v`` bottom to top, each box side and the
+floor covered by its texture once (a panel's front side only), a cylinder's side wrapped
+once around. The texture colour is multiplied by the body colour, as PyBullet does. The
+triangles of closed solids (boxes, prisms) are wound counter-clockwise seen from outside
+and marked ``closed``, as are the faces of a mesh part's closed solids
+(:attr:`~homing_gym.scenes.mesh_part.MeshPart.solids`): from outside a solid, its faces
+turned away are hidden behind its other faces, so the renderer skips them.
 """
 
 from __future__ import annotations
@@ -22,24 +21,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from homing_gym.scenes.base import Landmark, Scene
+from homing_gym.scenes.base import Scene
 from homing_gym.scenes.mesh_part import MeshPart
+from homing_gym.solids import Solid, floor_rectangle, floor_top, landmark_solid, wall_solid
 from homing_gym.textures import load_texture
 
 #: Sides of the prism that stands for a cylinder: the silhouette is within
 #: ``r (1 - cos(pi/64))`` = 0.1 % of the radius of the true circle.
 CYLINDER_SIDES = 64
-#: Margin (metres) of the floor beyond the scene bounds, as in the simulator.
-FLOOR_MARGIN = 2.0
-#: How far (metres) the drawn floor lies below z = 0 in scenes with mesh parts, so that a
-#: mesh's own ground at z = 0 is drawn instead of flickering against it.
-MESH_FLOOR_DROP = 0.002
-
-
-def floor_top(scene: Scene) -> float:
-    """Height (metres) of the drawn floor's top face: 0, or :data:`MESH_FLOOR_DROP`
-    below 0 in a scene with mesh parts."""
-    return -MESH_FLOOR_DROP if scene.meshes else 0.0
 
 
 @dataclass
@@ -109,6 +98,15 @@ class _Builder:
         c, t = np.asarray(corners, np.float64), np.asarray(uv, np.float64)
         for i, j, k in ((0, 1, 2), (0, 2, 3)):
             self.triangle(c[[i, j, k]], t[[i, j, k]], color, tex, inside)
+
+    def solid(self, solid: Solid) -> None:
+        """The sides of a box, panel or cylinder (textured as :class:`Solid` says)."""
+        tex = self.texture_id(solid.texture)
+        if solid.shape == "cylinder":
+            self.cylinder(solid.centre, solid.radius, solid.height, solid.yaw, solid.color, tex)
+        else:
+            self.box(solid.centre, solid.half, solid.yaw, solid.color, tex,
+                     front_only_uv=solid.shape == "panel")
 
     def box(self, centre, half, yaw: float, color, tex: int, front_only_uv: bool = False) -> None:
         """A box; every side textured once (``front_only_uv``: only the local +y side,
@@ -180,35 +178,18 @@ class _Builder:
                          self.textures, np.array(self.closed, bool))
 
 
-def _landmark(b: _Builder, lm: Landmark) -> None:
-    centre = (lm.position[0], lm.position[1], lm.base + lm.height / 2)
-    tex = b.texture_id(lm.texture)
-    if lm.shape == "cylinder":
-        b.cylinder(centre, lm.radius, lm.height, lm.yaw, lm.color, tex)
-    else:
-        half = (lm.extent[0] / 2, lm.extent[1] / 2, lm.height / 2)
-        b.box(centre, half, lm.yaw, lm.color, tex, front_only_uv=lm.shape == "panel")
-
-
 def world_mesh(scene: Scene) -> WorldMesh:
     """The triangles of ``scene``'s floor (if ``ground_plane``), walls, landmarks and mesh
     parts (see the module doc)."""
     b = _Builder()
-    (xmin, ymin), (xmax, ymax) = scene.bounds
-    x0, x1 = xmin - FLOOR_MARGIN, xmax + FLOOR_MARGIN
-    y0, y1 = ymin - FLOOR_MARGIN, ymax + FLOOR_MARGIN
     if scene.ground_plane:
+        x0, y0, x1, y1 = floor_rectangle(scene)
         z = floor_top(scene)
         b.quad([(x0, y0, z), (x1, y0, z), (x1, y1, z), (x0, y1, z)],
                [(0, 0), (1, 0), (1, 1), (0, 1)], scene.floor_color,
                b.texture_id(scene.floor_texture))
-    for wall in scene.walls:
-        (wx0, wy0), (wx1, wy1) = wall.start, wall.end
-        b.box(((wx0 + wx1) / 2, (wy0 + wy1) / 2, wall.height / 2),
-              ((wall.length + wall.thickness) / 2, wall.thickness / 2, wall.height / 2),
-              math.atan2(wy1 - wy0, wx1 - wx0), wall.color, b.texture_id(wall.texture))
-    for lm in scene.landmarks:
-        _landmark(b, lm)
+    for solid in [*map(wall_solid, scene.walls), *map(landmark_solid, scene.landmarks)]:
+        b.solid(solid)
     for part in scene.meshes:
         b.part(part)
     return b.mesh()
