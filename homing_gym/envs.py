@@ -83,6 +83,8 @@ class LocalHomingEnv(HomingEnv):
     Everything is drawn from the generator seeded by ``reset(seed=...)``.
     ``reset(options={"home": (x, y, yaw), "start": (x, y, yaw)})`` sets either pose
     instead (metres, radians; e.g. to place the robot on a grid for a homing vector field).
+    ``env.unwrapped.set_start_distance((min, max))`` changes the range for the following
+    resets (a training curriculum's hook; ``VecEnv.env_method`` reaches it through wrappers).
 
     ## Episode end
 
@@ -147,6 +149,20 @@ class LocalHomingEnv(HomingEnv):
         task = LocalHomingTask(start_distance=start_distance, success_radius=success_radius,
                                success_on=success_on, reward=reward)
         super().__init__(task, scene, **kwargs)
+
+    def set_start_distance(self, start_distance: tuple[float, float]) -> None:
+        """Draw the starts of the following resets ``start_distance`` = (min, max) metres
+        from home (the episode under way keeps its start): the hook of a training
+        curriculum, e.g. ``vec_env.env_method("set_start_distance", (0.2, 0.6))``. Checked
+        as the argument ``start_distance`` is (also against the current scene); a bad
+        value raises ``ValueError`` and changes nothing."""
+        previous = self.task.start_distance
+        self.task.set_start_distance(start_distance)
+        try:
+            self.task.check_scene(self.scene)
+        except ValueError:
+            self.task.start_distance = previous
+            raise
 
 
 class RouteFollowingEnv(HomingEnv):

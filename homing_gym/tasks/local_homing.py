@@ -19,18 +19,24 @@ class LocalHomingTask(GoalReachingTask):
     def __init__(self, start_distance: tuple[float, float] = (0.3, 1.5),
                  success_radius: float = 0.15, success_on: str = "reach",
                  reward: RewardConfig = RewardConfig(), clearance_margin: float = 0.22):
+        super().__init__(success_radius, success_on, reward)
+        self.set_start_distance(start_distance)
+        self.clearance_margin = clearance_margin
+
+    def set_start_distance(self, start_distance: tuple[float, float]) -> None:
+        """Draw the following episodes' starts ``start_distance`` = (min, max) metres from
+        home, min at least ``success_radius``; a bad value raises ``ValueError`` and
+        leaves the range as it was."""
         lo, hi = (start_distance if np.ndim(start_distance) == 1 and len(start_distance) == 2
                   else (math.nan, math.nan))
         if not (math.isfinite(lo) and math.isfinite(hi) and 0 <= lo <= hi):
             raise ValueError(f"start_distance must be (min, max) metres with 0 <= min <= max, "
                              f"got {start_distance!r}")
-        super().__init__(success_radius, success_on, reward)
         if lo < self.success_radius:
             raise ValueError(f"start_distance {start_distance!r} m must start at or beyond "
                              f"success_radius {self.success_radius!r} m: an episode must not "
                              f"begin at home")
         self.start_distance = (float(lo), float(hi))
-        self.clearance_margin = clearance_margin
 
     def check_scene(self, scene: Scene) -> None:
         width, depth = scene.size

@@ -9,7 +9,8 @@ YAML), then the dedicated flags. A run folder holds ``model.zip`` (final),
 ``best_model.zip`` and ``evaluations.npz`` (``EvalCallback`` on held-out seeds, with
 success rates), ``checkpoints/``, ``config.yml``, ``command.txt``, ``versions.json``,
 ``summary.json`` (timesteps, wall time, env steps per second of ``learn()``),
-TensorBoard logs in ``tb/`` and ``learning_curve.png``.
+TensorBoard logs in ``tb/`` and ``learning_curve.png``; with a ``curriculum``,
+``curriculum.json`` (the stages reached and when).
 """
 
 from __future__ import annotations
@@ -41,6 +42,8 @@ import homing_gym
 from homing_gym.cli import command_parser
 from homing_train.extras import MissingExtraError, require_extra
 from homing_train.learning import EXTRACTORS
+from homing_train.learning.curriculum import (HOOK, CurriculumCallback, CurriculumSettings,
+                                              last_stage, mark_stages, plot_training_success)
 from homing_train.learning.imitation import dagger
 from homing_train.learning.ppo_settings import PPO_KEYS, check_ppo, ppo_arguments
 from homing_train.learning.pretrain import pretrain
@@ -78,6 +81,7 @@ class TrainConfig:
     warm_start_learning_rate: float = 3e-4
     init_policy: str | None = None
     critic_warmup_steps: int = 0
+    curriculum: dict | None = None
     ppo: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -108,6 +112,8 @@ class TrainConfig:
             raise ValueError(f"eval_deterministic must be true or false, got "
                              f"{self.eval_deterministic!r}")
         check_ppo(self.ppo, self.n_envs)
+        if self.curriculum is not None:
+            CurriculumSettings.from_value(self.curriculum)
         scenes = self.env_kwargs.get("scene")
         if isinstance(scenes, list):
             if not scenes or not all(isinstance(name, str) for name in scenes):
@@ -124,6 +130,11 @@ class TrainConfig:
         if isinstance(scenes, list):
             return {**self.env_kwargs, "scene": scenes[rank % len(scenes)]}
         return self.env_kwargs
+
+    @property
+    def curriculum_settings(self) -> CurriculumSettings | None:
+        """The checked ``curriculum`` setting, or ``None`` without one."""
+        return None if self.curriculum is None else CurriculumSettings.from_value(self.curriculum)
 
     @property
     def n_scenes(self) -> int:
@@ -281,7 +292,9 @@ def latest_checkpoint(run: Path) -> Path | None:
 
 def plot_learning_curve(run: Path) -> Path | None:
     """``learning_curve.png`` from ``evaluations.npz``: mean return and success rate; with
-    a ``pretrain.json``, a first panel of the pretraining's agreement with the oracle."""
+    a ``pretrain.json``, a first panel of the pretraining's agreement with the oracle; with
+    a ``curriculum.json``, the stages marked and a last panel of the training episodes'
+    success rate (:func:`~homing_train.learning.curriculum.plot_training_success`)."""
     data_path = run / "evaluations.npz"
     if not data_path.is_file():
         return None
@@ -293,9 +306,10 @@ def plot_learning_curve(run: Path) -> Path | None:
     data = np.load(data_path)
     steps = data["timesteps"]
     pretrained = run / "pretrain.json"
-    panels = 2 if pretrained.is_file() else 1
+    stages = last_stage(run / "curriculum.json")[1]
+    panels = 1 + pretrained.is_file() + bool(stages)
     fig, axes = plt.subplots(1, panels, figsize=(6 * panels, 3.5), constrained_layout=True)
-    axes = np.atleast_1d(axes)
+    axes = list(np.atleast_1d(axes))
     if pretrained.is_file():
         record = json.loads(pretrained.read_text())
         axes[0].plot(record["samples"], 100 * np.asarray(record["agreement"]),
@@ -304,6 +318,8 @@ def plot_learning_curve(run: Path) -> Path | None:
         axes[0].set_ylabel("agreement with the oracle (%)")
         axes[0].set_ylim(0, 100)
         axes[0].set_title("pretraining: validation positions")
+    if stages:
+        plot_training_success(axes.pop(), run / "tb", stages)
     ax = axes[-1]
     ax.plot(steps, data["results"].mean(axis=1), color="tab:blue", marker="o", ms=3)
     ax.set_xlabel("environment steps")
@@ -314,6 +330,7 @@ def plot_learning_curve(run: Path) -> Path | None:
                  ms=3)
         ax2.set_ylabel("success rate (%)", color="tab:green")
         ax2.set_ylim(0, 100)
+    mark_stages(ax, stages)
     ax.set_title(f"{run.name}: evaluation on held-out seeds")
     out = run / "learning_curve.png"
     fig.savefig(out, dpi=100)
@@ -381,6 +398,21 @@ def warm_starts(config: TrainConfig, progress: bool = True) -> list[tuple[str, A
     return steps
 
 
+def check_curriculum(env: gym.Env, curriculum: CurriculumSettings) -> None:
+    """Raise ``ValueError`` unless the unwrapped ``env`` has the curriculum's hook and
+    accepts every stage (its own checks: success radius, scene size); ``env`` is left at
+    the last stage."""
+    hook = getattr(env, HOOK, None)
+    if hook is None:
+        raise ValueError(f"curriculum: {type(env).__name__} has no {HOOK}() to change its "
+                         f"start distance (LocalHoming-v0 has one)")
+    for i, stage in enumerate(curriculum.start_distance):
+        try:
+            hook(stage)
+        except ValueError as err:
+            raise ValueError(f"curriculum stage {i}: {err}") from err
+
+
 def new_model(config: TrainConfig, env, **kwargs):
     """A fresh PPO model of ``config`` on the vectorised ``env`` (``kwargs``: more PPO
     arguments, e.g. ``tensorboard_log``)."""
@@ -419,6 +451,9 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
     made = probe.unwrapped
     config.env_kwargs.setdefault("renderer", made.camera.config.renderer)
     config.env_kwargs.setdefault("physics_substeps", made.physics_substeps)
+    curriculum = config.curriculum_settings
+    if curriculum is not None:
+        check_curriculum(made, curriculum)
     probe.close()
     out.mkdir(parents=True, exist_ok=True)
     (out / "config.yml").write_text(yaml.safe_dump(asdict(config), sort_keys=False))
@@ -459,6 +494,12 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
             _restore_evaluations(eval_cb, out)
         ckpt_cb = CheckpointCallback(max(config.checkpoint_freq // config.n_envs, 1),
                                      str(out / "checkpoints"), name_prefix="ppo")
+        callbacks = [eval_cb, ckpt_cb]
+        if curriculum is not None:     # a resumed run goes on at the stage it had reached
+            stage, history = (last_stage(out / "curriculum.json") if checkpoint is not None
+                              else (0, []))
+            callbacks.append(CurriculumCallback(curriculum, out / "curriculum.json", stage,
+                                                history))
         t0 = time.perf_counter()
         # the first critic_warmup_steps fit the value function only (actor frozen), so that
         # a warm-started actor is not updated with a random critic's advantages
@@ -470,7 +511,7 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
                 if steps <= 0:
                     continue
                 set_actor_trainable(model.policy, not critic_only)
-                model.learn(steps, callback=[eval_cb, ckpt_cb], progress_bar=progress,
+                model.learn(steps, callback=callbacks, progress_bar=progress,
                             reset_num_timesteps=fresh, tb_log_name="ppo")
                 fresh = False
         except KeyboardInterrupt:           # Ctrl-C: keep what was learned, say so
