@@ -10,8 +10,10 @@ ends with the papers' claims beside our cells (:func:`claims_markdown`) and each
 success aggregated over ``local-common`` and ``unseen`` with stratified-bootstrap
 intervals (:func:`aggregate_markdown`).
 
-Shipped policies are run with the settings recorded beside them (their panorama size,
-action type, control period); where a protocol caps the episode length
+Shipped policies, and PPO model zips given by path (``homing-eval --protocol unseen
+--policy runs/RUN/best_model.zip``), are run with the settings recorded beside them
+(their ``.yml``, or their run folder's ``config.yml``: panorama size, action type, control
+period); where a protocol caps the episode length
 (``max_episode_steps``, counted in steps of the default 0.1 s control period) a policy with
 another control period gets the same time, not the same number of steps.
 
@@ -26,6 +28,7 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 import re
 import sys
 from dataclasses import asdict, dataclass
@@ -42,7 +45,8 @@ import homing_baselines  # noqa: E402
 from homing_gym.cli import command_parser  # noqa: E402
 from homing_train.extras import missing_extra  # noqa: E402
 from homing_train.harness.evaluate import EpisodeRecord, evaluate, summarize  # noqa: E402
-from homing_train.harness.policies import shipped_policies  # noqa: E402
+from homing_train.harness.policies import (ShippedPolicy, recorded_settings,  # noqa: E402
+                                           shipped_policies)
 from homing_train.harness.metrics import aggregate_success, wilson_interval  # noqa: E402
 from homing_train.harness.protocols import (POLICIES, PROTOCOLS, Protocol,  # noqa: E402
                                             episodes_key)
@@ -110,16 +114,22 @@ def _slug(text: str) -> str:
 def run_cell(protocol: Protocol, method: str, out: Path, episodes: int | None = None,
              workers: int = 1, progress: bool = True, resume: bool = False,
              backend: str = "local", address: str | None = None) -> Cell:
-    """Run ``method`` (a controller name or a shipped policy's) on every setting of
-    ``protocol`` (``episodes`` per setting, default the protocol's) into ``out``
-    (``backend``/``address``: :func:`homing_train.harness.evaluate.run_episodes`)."""
+    """Run ``method`` (a controller name, a shipped policy's, or the path of a PPO model
+    zip, evaluated with :func:`~homing_train.harness.policies.recorded_settings` as a
+    shipped one is) on every setting of ``protocol`` (``episodes`` per setting, default
+    the protocol's) into ``out`` (``backend``/``address``:
+    :func:`homing_train.harness.evaluate.run_episodes`)."""
     n = protocol.episodes if episodes is None else episodes
     if n < 1:
         raise ValueError(f"episodes must be >= 1, got {n}")
     shipped = shipped_for({s.env_id for s in protocol.settings})
+    if method.endswith(".zip") and os.path.isfile(method):
+        recorded = recorded_settings(method)
+        shipped[method] = ShippedPolicy(Path(method), recorded.env_kwargs, recorded.params,
+                                        recorded.env_id)
     if method not in shipped and method not in homing_baselines.available():
         raise ValueError(f"unknown method {method!r} for protocol {protocol.name!r}; "
-                         f"allowed: {cell_methods(protocol)}")
+                         f"allowed: {cell_methods(protocol)} or a PPO model .zip")
     out.mkdir(parents=True, exist_ok=True)
     records: list[EpisodeRecord] = []
     per_setting = {}

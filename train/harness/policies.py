@@ -69,7 +69,8 @@ class RecordedSettings:
     """How a policy zip is evaluated, from the ``.yml`` beside it (written by
     ``homing_train.learning.ship``): ``env_kwargs`` (``eval_env_kwargs``), ``params``
     (``eval_params``, e.g. ``{"deterministic": False}``) and the ``env_id`` it was trained
-    on; ``source`` the ``.yml`` path, ``None`` when there is none."""
+    on, or from its run folder's ``config.yml`` (no params); ``source`` the file read,
+    ``None`` when there is none."""
 
     env_kwargs: dict[str, Any] = field(default_factory=dict)
     params: dict[str, Any] = field(default_factory=dict)
@@ -77,11 +78,27 @@ class RecordedSettings:
     source: str | None = None
 
 
+def eval_env_kwargs(train_env_kwargs: dict[str, Any]) -> dict[str, Any]:
+    """The env kwargs a policy trained with ``train_env_kwargs`` is evaluated with: all but
+    the training ``scene``, so that the evaluation's own scene applies."""
+    return {k: v for k, v in train_env_kwargs.items() if k != "scene"}
+
+
 def recorded_settings(zip_path: str) -> RecordedSettings:
-    """The evaluation settings recorded beside the policy zip ``zip_path``."""
+    """The evaluation settings recorded beside the policy zip ``zip_path``: its ``.yml``
+    (a shipped policy), else the ``config.yml`` of the ``homing-train`` run folder it lies
+    in (:func:`eval_env_kwargs` of the training env kwargs)."""
     import yaml
 
     meta_path = os.path.splitext(zip_path)[0] + ".yml"
+    run_config = os.path.join(os.path.dirname(zip_path), "config.yml")
+    if not os.path.isfile(meta_path) and os.path.isfile(run_config):
+        try:
+            config = yaml.safe_load(open(run_config).read()) or {}
+        except yaml.YAMLError as err:
+            raise ValueError(f"{run_config}: not readable YAML ({err})") from None
+        return RecordedSettings(eval_env_kwargs(dict(config.get("env_kwargs") or {})), {},
+                                config.get("env_id"), run_config)
     if not os.path.isfile(meta_path):
         return RecordedSettings()
     try:

@@ -61,7 +61,8 @@ def _extractor_classes() -> dict[str, type]:
     from stable_baselines3.common import torch_layers
 
     from homing_train.learning import extractor
-    known = [extractor.PanoramaGoalExtractor, torch_layers.CombinedExtractor,
+    known = [extractor.PanoramaGoalExtractor, extractor.HorizonBandExtractor,
+             torch_layers.CombinedExtractor,
              torch_layers.NatureCNN, torch_layers.FlattenExtractor]
     return {cls.__name__: cls for cls in known}
 

@@ -22,7 +22,7 @@ from pathlib import Path
 import yaml
 
 from homing_gym.cli import command_parser
-from homing_train.harness.policies import POLICY_DIR
+from homing_train.harness.policies import POLICY_DIR, eval_env_kwargs
 
 MAX_BYTES = 10 * 2**20
 #: ``--model`` choices: the run folder's model files.
@@ -54,10 +54,9 @@ def ship_run(run: Path, name: str, folder: Path = POLICY_DIR, model: str = "best
                          f"must stay under {MAX_BYTES / 2**20:.0f} MiB")
     config = yaml.safe_load((run / "config.yml").read_text())
     summary = json.loads((run / "summary.json").read_text())
-    eval_env_kwargs = {k: v for k, v in config["env_kwargs"].items() if k != "scene"}
     meta = {
         "env_id": config["env_id"],
-        "eval_env_kwargs": eval_env_kwargs,
+        "eval_env_kwargs": eval_env_kwargs(config["env_kwargs"]),
         "eval_params": {"deterministic": not stochastic},
         "model": MODELS[model],
         "chosen": why or ("best evaluation-callback return on held-out training seeds"

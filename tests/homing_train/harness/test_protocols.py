@@ -125,6 +125,29 @@ def test_oracle_cell_on_yukim_stops_at_the_nest_and_its_command_reproduces_it(tm
         cell.summary["final_distance_mean"])
 
 
+def test_a_run_folders_model_runs_a_protocol_with_its_training_env_kwargs(tmp_path):
+    """A PPO zip given by path (here a band-extractor model) gets its run folder's env
+    kwargs (16 x 64 panoramas) under the protocol's own scene and stop rule."""
+    from homing_train.learning.train import main as train_main
+
+    run = tmp_path / "run"
+    train_main(["--timesteps", "64", "--out", str(run), "--extractor", "band", "--n-envs", "1",
+                "--vec", "dummy", "--no-progress", "--env-kwargs",
+                json.dumps({"panorama_shape": [16, 64], "max_episode_steps": 16}),
+                "--hp", "n_steps=64", "--hp", "batch_size=32", "--hp", "n_epochs=1",
+                "--hp", "features_dim=32"])
+    model = str(run / "model.zip")
+    cell = run_cell(protocol("yukim"), model, tmp_path / "cell", episodes=4, progress=False)
+    assert cell.summary["episodes"] == 4 and cell.method == model
+    (setting_path,) = [p for p in (tmp_path / "cell").glob("*.json") if p.name != "cell.json"]
+    setting = json.loads(setting_path.read_text())
+    assert setting["env_kwargs"]["panorama_shape"] == [16, 64]
+    assert setting["env_kwargs"]["scene"] == "arena"
+    assert setting["env_kwargs"]["success_on"] == "stop"
+    with pytest.raises(ValueError, match="or a PPO model .zip"):
+        run_cell(protocol("yukim"), str(tmp_path / "missing.zip"), tmp_path / "x")
+
+
 def test_protocol_mode_refuses_settings_the_protocol_fixes(tmp_path, capsys):
     with pytest.raises(SystemExit) as exit_:
         eval_command.main(["--protocol", "yukim", "--policy", "oracle", "--env-kwargs",
