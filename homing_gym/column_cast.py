@@ -150,6 +150,9 @@ def cast_columns(tris: np.ndarray, normals: np.ndarray, closed: np.ndarray,
         for shift in (-2 * math.pi, 0.0, 2 * math.pi):
             if everywhere and shift != 0.0:
                 continue
+            if not everywhere and (hi + shift + 1e-12 <= beta[W - 1]
+                                   or lo + shift - 1e-12 > beta[0]):
+                continue          # no column in this turn of the span: skip the searches
             j0 = _first_below(beta, hi + shift + 1e-12) if not everywhere else 0
             j1 = _first_below(beta, lo + shift - 1e-12) if not everywhere else W
             for j in range(j0, j1):

@@ -63,6 +63,9 @@ class Simulator:
         self.time_step = time_step
         self._vertices, self._vertices_of = np.zeros((0, 3)), None   # world_vertices' cache
         self._gui = gui
+        #: Whether PyBullet draws the world (its renderers, or the GUI): only then do the
+        #: bodies get visual shapes, colours and textures (the ray caster draws its own).
+        self._drawn = self.caster is None or gui
         self._robot_config = robot_config
         self._step_simulation = c.stepSimulation      # BulletClient builds a new partial on
         self._contact_points = c.getContactPoints     # every attribute access: keep these
@@ -105,6 +108,8 @@ class Simulator:
         return self._textures[name]
 
     def _paint(self, body: int, color, texture: str | None) -> None:
+        if not self._drawn:
+            return
         tex = self._texture(texture)
         self.client.changeVisualShape(body, -1, rgbaColor=list(color),
                                       textureUniqueId=-1 if tex is None else tex)
@@ -117,7 +122,7 @@ class Simulator:
         col = c.createCollisionShape(p.GEOM_PLANE)
         vis = (c.createVisualShape(p.GEOM_BOX, halfExtents=half, visualFramePosition=centre,
                                    rgbaColor=list(scene.floor_color))
-               if scene.ground_plane else -1)
+               if scene.ground_plane and self._drawn else -1)
         body = c.createMultiBody(0, col, vis, [0, 0, 0])
         if scene.ground_plane:
             self._paint(body, scene.floor_color, scene.floor_texture)
@@ -129,11 +134,12 @@ class Simulator:
     def _hide(self, body: int) -> None:
         """Keep PyBullet's renderers from drawing a body that has no visual shape (they
         draw its collision shape otherwise)."""
-        self.client.changeVisualShape(body, -1, rgbaColor=[1, 1, 1, 0])
+        if self._drawn:
+            self.client.changeVisualShape(body, -1, rgbaColor=[1, 1, 1, 0])
 
     def _make_part(self, part: MeshPart, band: tuple[float, float]) -> list[int]:
         """Bodies of a mesh part: one static concave collision body of its triangles that
-        reach into ``band`` (if it collides and any do), and, for PyBullet's renderers,
+        reach into ``band`` (if it collides and any do), and, where PyBullet draws,
         one visual body (no collision) per face colour (colours rounded to 1/16: a
         PyBullet mesh takes one colour)."""
         c, bodies = self.client, []
@@ -144,7 +150,7 @@ class Simulator:
                                          flags=p.GEOM_FORCE_CONCAVE_TRIMESH)
             bodies.append(c.createMultiBody(0, col, -1, [0, 0, 0]))
             self._hide(bodies[-1])
-        if self.caster is None:
+        if self._drawn:
             levels = np.round(part.face_colors * 16).astype(np.int64)
             keys = (levels[:, 0] * 17 + levels[:, 1]) * 17 + levels[:, 2]
             for key in np.unique(keys):
@@ -158,9 +164,10 @@ class Simulator:
         return bodies
 
     def _body(self, solid: Solid, visible: bool = True) -> int:
-        """A static body of ``solid``: its collision shape, and (``visible``) its painted
-        visual shape for PyBullet's renderers; an invisible one is hidden."""
+        """A static body of ``solid``: its collision shape, and (``visible``, where PyBullet
+        draws) its painted visual shape; an invisible one is hidden."""
         c, half = self.client, list(solid.half)
+        visible = visible and self._drawn
         if solid.shape == "cylinder":
             col = c.createCollisionShape(p.GEOM_CYLINDER, radius=solid.radius,
                                          height=solid.height)

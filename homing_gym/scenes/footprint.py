@@ -78,14 +78,14 @@ class ClearanceField:
         return ndimage.map_coordinates(self.field, idx.T, order=1, mode="constant", cval=0.0)
 
 
-def rasterise(polygons: list[np.ndarray], origin, resolution: float,
+def rasterise(triangles: np.ndarray, origin, resolution: float,
               shape: tuple[int, int]) -> np.ndarray:
-    """Boolean grid ``shape = (nx, ny)``, True in every cell a polygon (floor points,
-    metres) covers or whose outline crosses."""
+    """Boolean grid ``shape = (nx, ny)``, True in every cell a triangle ``(M, 3, 2)``
+    (floor points, metres) covers or whose outline crosses."""
     grid = np.zeros((shape[1], shape[0]), np.uint8)          # OpenCV: rows are y
-    if polygons:
+    if len(triangles):
         scale = 2 ** _SHIFT / resolution
-        pts = [np.round((np.asarray(p) - origin) * scale).astype(np.int32) for p in polygons]
+        pts = list(np.round((np.asarray(triangles) - origin) * scale).astype(np.int32))
         cv2.fillPoly(grid, pts, 1, cv2.LINE_8, _SHIFT)
         cv2.polylines(grid, pts, True, 1, 1, cv2.LINE_8, _SHIFT)
     return grid.T.astype(bool)
@@ -114,7 +114,7 @@ def _fill_solid(blocked: np.ndarray, tris: np.ndarray, origin, resolution: float
     a, b = np.maximum(low, 0), np.minimum(high, blocked.shape)
     if np.any(b <= a):
         return                                  # wholly off the grid
-    window = ndimage.binary_fill_holes(rasterise(list(tris[..., :2]), origin + low * resolution,
+    window = ndimage.binary_fill_holes(rasterise(tris[..., :2], origin + low * resolution,
                                                  resolution, tuple(high - low)))
     blocked[a[0]:b[0], a[1]:b[1]] |= window[a[0] - low[0]:b[0] - low[0],
                                             a[1] - low[1]:b[1] - low[1]]
@@ -125,15 +125,16 @@ def clearance_field(parts: tuple[MeshPart, ...], bounds, band) -> ClearanceField
     triangles in ``band`` and the insides of their closed solids; ``None`` when none of
     them reaches into ``band``."""
     colliding = [part for part in parts if part.collision]
-    polygons = [tri[:, :2] for part in colliding for tri in band_triangles(part, band)]
-    if not polygons:
+    triangles = np.concatenate([np.zeros((0, 3, 3))]
+                               + [band_triangles(part, band) for part in colliding])[..., :2]
+    if not len(triangles):
         return None
     (xmin, ymin), (xmax, ymax) = bounds
     width, depth = xmax - xmin + 2 * MARGIN, ymax - ymin + 2 * MARGIN
     resolution = max(RESOLUTION, math.sqrt(width * depth / MAX_CELLS))
     shape = (int(math.ceil(width / resolution)) + 1, int(math.ceil(depth / resolution)) + 1)
     origin = np.array([xmin - MARGIN, ymin - MARGIN])
-    blocked = rasterise(polygons, origin, resolution, shape)
+    blocked = rasterise(triangles, origin, resolution, shape)
     for part in colliding:
         for tris in solids(part, band):
             _fill_solid(blocked, tris, origin, resolution)

@@ -16,6 +16,7 @@ robot bumps into trunks, rocks and bushes (their solid cross-section at its heig
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 import trimesh
@@ -32,42 +33,57 @@ HILL_DISTANCE = (18.0, 26.0)
 GAP = 0.4
 
 
-def _part(meshes: list[trimesh.Trimesh], colors: list[np.ndarray], name: str,
+def _part(meshes: list[tuple[np.ndarray, np.ndarray]], colors: list[np.ndarray], name: str,
           collision: bool) -> MeshPart:
-    """One part of several closed solids (each mesh one solid, wound outwards), each face
-    in its mesh's colour (``colors``: one RGB per mesh, or one per face)."""
-    joined = trimesh.util.concatenate(meshes)
-    face_colors = np.concatenate([np.broadcast_to(c, (len(m.faces), 3))
-                                  for m, c in zip(meshes, colors)])
-    ends = np.cumsum([len(m.faces) for m in meshes])
-    solids = tuple(np.arange(end - len(m.faces), end) for m, end in zip(meshes, ends))
-    return MeshPart(joined.vertices, joined.faces, np.clip(face_colors, 0, 1),
-                    collision=collision, name=name, solid_faces=solids)
+    """One part of several closed solids (each mesh, ``(vertices, faces)``, one solid,
+    wound outwards), each face in its mesh's colour (``colors``: one RGB per mesh)."""
+    counts = [len(faces) for _, faces in meshes]
+    offsets = np.cumsum([0] + [len(vertices) for vertices, _ in meshes[:-1]])
+    vertices = np.concatenate([v for v, _ in meshes])
+    faces = np.concatenate([f + o for (_, f), o in zip(meshes, offsets)])
+    face_colors = np.concatenate([np.broadcast_to(c, (n, 3)) for n, c in zip(counts, colors)])
+    ends = np.cumsum(counts)
+    solids = tuple(np.arange(end - n, end) for n, end in zip(counts, ends))
+    return MeshPart(vertices, faces, np.clip(face_colors, 0, 1), collision=collision,
+                    name=name, solid_faces=solids)
 
 
-def _lump(rng: np.random.Generator, centre, size) -> trimesh.Trimesh:
-    """A closed lumpy solid: an icosphere scaled to ``size`` (x, y, z half sizes), its
-    corners pushed in and out by up to 25 %, standing on the ground at ``centre``."""
+@lru_cache(maxsize=1)
+def _unit_ball() -> tuple[np.ndarray, np.ndarray]:
+    """Vertices and faces of trimesh's icosphere of one subdivision and radius 1 (made
+    once: every lump and crown starts from it)."""
     ball = trimesh.creation.icosphere(subdivisions=1)
-    vertices = ball.vertices * rng.uniform(0.75, 1.25, (len(ball.vertices), 1))
+    vertices, faces = np.array(ball.vertices), np.array(ball.faces)
+    vertices.flags.writeable = faces.flags.writeable = False
+    return vertices, faces
+
+
+def _lump(rng: np.random.Generator, centre, size) -> tuple[np.ndarray, np.ndarray]:
+    """A closed lumpy solid ``(vertices, faces)``: an icosphere scaled to ``size`` (x, y, z
+    half sizes), its corners pushed in and out by up to 25 %, standing on the ground at
+    ``centre``."""
+    ball, faces = _unit_ball()
+    vertices = ball * rng.uniform(0.75, 1.25, (len(ball), 1))
     vertices = vertices * np.asarray(size)
     vertices[:, 2] -= vertices[:, 2].min() + 0.05 * size[2]     # sunk a little
-    return trimesh.Trimesh(vertices + [centre[0], centre[1], 0.0], ball.faces, process=False)
+    return vertices + [centre[0], centre[1], 0.0], faces
 
 
 def _tree(rng: np.random.Generator, xy) -> tuple[list, list]:
+    """A trunk and a crown (each ``(vertices, faces)``) at floor point ``xy``, and their
+    colours."""
     radius, height = float(rng.uniform(0.04, 0.15)), float(rng.uniform(1.5, 4.0))
     trunk = trimesh.creation.cylinder(radius=radius, height=height, sections=10)
     trunk.apply_translation((xy[0], xy[1], height / 2))
     crown_r = float(rng.uniform(0.4, 1.2))
-    crown = trimesh.creation.icosphere(subdivisions=1, radius=1.0)
-    crown.vertices *= [crown_r, crown_r, crown_r * rng.uniform(0.8, 1.6)]
-    crown.vertices *= rng.uniform(0.85, 1.15, (len(crown.vertices), 1))
+    ball, faces = _unit_ball()
+    crown = ball * [crown_r, crown_r, crown_r * rng.uniform(0.8, 1.6)]
+    crown *= rng.uniform(0.85, 1.15, (len(crown), 1))
     low = max(0.5, height - crown_r)
-    crown.apply_translation((xy[0], xy[1], low - crown.vertices[:, 2].min()))
+    crown = crown + (xy[0], xy[1], low - crown[:, 2].min())
     bark = np.array([0.35, 0.25, 0.15]) * rng.uniform(0.6, 1.3)
     leaves = np.array([rng.uniform(0.1, 0.35), rng.uniform(0.35, 0.65), rng.uniform(0.05, 0.25)])
-    return [trunk, crown], [bark, leaves]
+    return [(trunk.vertices, trunk.faces), (crown, faces)], [bark, leaves]
 
 
 def _ground(rng: np.random.Generator) -> MeshPart:
