@@ -11,12 +11,19 @@ configuration, in the same run:
   ``--workers`` processes;
 * ``ratio``: time per env step divided by time per render (1.25 = the env adds 25%).
 
-Worlds: ``arena`` (Yu & Kim's arena, 1,074 triangles), ``forest10k`` (40 trees as
+Worlds: ``arena`` (Yu & Kim's arena, 1,074 triangles, untextured), ``hallway`` (Hong's
+corridor: every wall, door and poster textured, so most rays sample a texture), ``forest10k`` (40 trees as
 64-sided prisms of random size in a walled 10 m square, 10,290 triangles) and
 ``mesh10k`` (a mesh world: 30 lumpy rocks and four walls of triangles, 9,650 triangles
 and the floor, :func:`mesh_world`). With
 ``tiny`` at 48 x 256 in the arena, homing-gym 0.1's default physics steps of 1/240 s
 (``physics_substeps=24``) are measured too.
+
+``--resets N`` also times ``env.reset()`` in the procedural worlds (:data:`RESET_SCENES`,
+LocalHoming-v0 with the default camera): with a new world at every reset
+(``episodes_per_world=1``: the world drawn, the PyBullet bodies and the ray caster's mesh
+built) and in the same world (the saved state restored, a new episode sampled, the goal
+snapshot rendered); medians of 5 blocks of ``N`` resets.
 """
 
 from __future__ import annotations
@@ -82,7 +89,10 @@ def mesh_world(rocks: int = 30, seed: int = 0) -> MeshScene:
 
 
 #: Worlds measured: scene kwargs.
-WORLDS = {"arena": {}, "forest10k": {"scene": forest_scene()}, "mesh10k": {"scene": mesh_world()}}
+WORLDS = {"arena": {}, "hallway": {"scene": "hallway"}, "forest10k": {"scene": forest_scene()},
+          "mesh10k": {"scene": mesh_world()}}
+#: The procedural scenes whose resets ``--resets`` times.
+RESET_SCENES = ("random_arena", "random_rooms", "random_nature")
 
 
 def configs(renderers: list[str], shapes: list[str],
@@ -169,6 +179,31 @@ def run_config(name: str, env_kwargs: dict, steps: int, workers: int, rounds: in
                            float(np.median(singles)), float(vector), workers)
 
 
+def reset_ms(scene: str, new_world: bool, n: int, blocks: int = 5) -> float:
+    """Median wall time (milliseconds) of one LocalHoming-v0 ``reset()`` in ``scene``, with
+    a new world at every reset or always the same one, over ``blocks`` blocks of ``n``."""
+    env = gym.make("homing_gym/LocalHoming-v0", scene=scene,
+                   episodes_per_world=1 if new_world else 10**9)
+    env.reset(seed=0)
+    times = []
+    for _ in range(blocks):
+        start = time.perf_counter()
+        for _ in range(n):
+            env.reset()
+        times.append((time.perf_counter() - start) / n * 1e3)
+    env.close()
+    return float(np.median(times))
+
+
+def reset_table(n: int) -> str:
+    """A Markdown table of :func:`reset_ms` for every scene of :data:`RESET_SCENES`."""
+    lines = ["| scene | reset, new world (ms) | reset, same world (ms) |", "|---|---|---|"]
+    for scene in tqdm(RESET_SCENES, desc="resets"):
+        lines.append(f"| {scene} | {reset_ms(scene, True, n):.1f} | "
+                     f"{reset_ms(scene, False, n):.2f} |")
+    return "\n".join(lines)
+
+
 def format_table(results: list[BenchmarkResult]) -> str:
     """A Markdown table of the results; ``env vs tiny``: env steps/s over those of
     ``renderer="tiny"`` at the same shape in the same run."""
@@ -204,15 +239,20 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--shapes", nargs="+", default=list(SHAPES), choices=list(SHAPES),
                         help="panorama shapes (H x W)")
     parser.add_argument("--worlds", nargs="+", default=["arena"], choices=list(WORLDS),
-                        help="worlds (forest10k: 10,290 triangles; mesh10k: a mesh world "
-                             "of 9,650 triangles)")
+                        help="worlds (hallway: textured; forest10k: 10,290 triangles; "
+                             "mesh10k: a mesh world of 9,650 triangles)")
     parser.add_argument("--json", help="also write the results to this JSON file")
+    parser.add_argument("--resets", type=int, default=0, metavar="N",
+                        help="also time N resets (x 5 blocks) in each procedural world, "
+                             "with a new world every time and in the same world")
     args = parser.parse_args(argv)
-    if args.steps < 10 or args.workers < 1:
-        parser.error("need --steps >= 10 and --workers >= 1")
+    if args.steps < 10 or args.workers < 1 or args.resets < 0:
+        parser.error("need --steps >= 10, --workers >= 1 and --resets >= 0")
     results = [run_config(name, kwargs, args.steps, args.workers)
                for name, kwargs in configs(args.renderers, args.shapes, args.worlds).items()]
     print(format_table(results))
+    if args.resets:
+        print(reset_table(args.resets))
     if args.json:
         with open(args.json, "w") as f:
             json.dump([_record(r) for r in results], f, indent=2)

@@ -177,7 +177,7 @@ def cast_columns(tris: np.ndarray, normals: np.ndarray, closed: np.ndarray,
                             weights[i, j, k] = seg[0, 2 + k] + u * (seg[1, 2 + k] - seg[0, 2 + k])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _texel(atlas: np.ndarray, levels: np.ndarray, m: int, s: float, v: float,
            out: np.ndarray) -> None:
     """Bilinear sample (wrapped) of mip level ``levels[m] = (offset, height, width)`` at
