@@ -59,7 +59,8 @@ BASE_PERIOD = 0.1
 class Cell:
     """One method on one protocol: the summary over all its episodes (success under
     the stop rule, ``reached_rate``, SPL, ... with 95% CIs), per-setting success and
-    episode counts, and the command that reproduces it."""
+    episode counts, and the command that reproduces it; ``privileged``: what beyond
+    pixels the protocol gives and the policy trained on (its shipped ``.yml``)."""
 
     protocol: str
     version: int
@@ -126,7 +127,7 @@ def run_cell(protocol: Protocol, method: str, out: Path, episodes: int | None = 
     if method.endswith(".zip") and os.path.isfile(method):
         recorded = recorded_settings(method)
         shipped[method] = ShippedPolicy(Path(method), recorded.env_kwargs, recorded.params,
-                                        recorded.env_id)
+                                        recorded.env_id, recorded.privileged)
     if method not in shipped and method not in homing_baselines.available():
         raise ValueError(f"unknown method {method!r} for protocol {protocol.name!r}; "
                          f"allowed: {cell_methods(protocol)} or a PPO model .zip")
@@ -152,10 +153,11 @@ def run_cell(protocol: Protocol, method: str, out: Path, episodes: int | None = 
             "episodes": len(result.episodes), "success_rate": result.summary["success_rate"],
             "reached_rate": result.summary["reached_rate"]}
     radius = protocol.success_radius(protocol.settings[0])
+    own = shipped[method].privileged if method in shipped else ""
     cell = Cell(protocol=protocol.name, version=protocol.version, method=method,
                 command=protocol.command(method, episodes),
                 summary=summarize(records, radius=radius), settings=per_setting,
-                privileged=protocol.privileged)
+                privileged="; ".join(p for p in (protocol.privileged, own) if p))
     (out / "cell.json").write_text(json.dumps(asdict(cell), indent=1))
     return cell
 
@@ -229,11 +231,15 @@ def _pct(summary: dict, key: str, ci: str) -> str:
 
 
 def matrix_markdown(cells: Sequence[Cell]) -> str:
-    """Success % [95% Wilson CI] by method and protocol, then one row per cell with
-    the other metrics and the command that reproduces it."""
+    """Success % [95% Wilson CI] by method and protocol (a method whose cells used
+    privileged data is named with it), then one row per cell with the other metrics and
+    the command that reproduces it."""
     protocols = list(dict.fromkeys(c.protocol for c in cells))
     methods = list(dict.fromkeys(c.method for c in cells))
     by = {(c.protocol, c.method): c for c in cells}
+    privileged = {m: "; ".join(dict.fromkeys(c.privileged for c in cells
+                                             if c.method == m and c.privileged))
+                  for m in methods}
     lines = ["Success: the agent stopped within the success radius of the goal (0.15 m; "
              "0.10 m in shiraishi-house; in briggs-corridors: stopped in front of the goal "
              "landmark); % with 95% Wilson interval, episodes per cell in the second table.",
@@ -243,7 +249,8 @@ def matrix_markdown(cells: Sequence[Cell]) -> str:
     for m in methods:
         row = [(_pct(by[(p, m)].summary, "success_rate", "success_ci") if (p, m) in by
                 else "") for p in protocols]
-        lines.append(f"| {m} | " + " | ".join(row) + " |")
+        label = f"{m} (privileged: {privileged[m]})" if privileged[m] else m
+        lines.append(f"| {label} | " + " | ".join(row) + " |")
     lines += ["", "| protocol | method | episodes | success % [95% CI] | reached % [95% CI] "
               "| SPL | final distance (cm) | command |", "|---|---|---:|---:|---:|---:|---:|---|"]
     for c in cells:

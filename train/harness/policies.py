@@ -70,12 +70,26 @@ class RecordedSettings:
     ``homing_train.learning.ship``): ``env_kwargs`` (``eval_env_kwargs``), ``params``
     (``eval_params``, e.g. ``{"deterministic": False}``) and the ``env_id`` it was trained
     on, or from its run folder's ``config.yml`` (no params); ``source`` the file read,
-    ``None`` when there is none."""
+    ``None`` when there is none; ``privileged``: what beyond pixels its training used
+    ("" if nothing: :func:`privileged_training`)."""
 
     env_kwargs: dict[str, Any] = field(default_factory=dict)
     params: dict[str, Any] = field(default_factory=dict)
     env_id: str | None = None
     source: str | None = None
+    privileged: str = ""
+
+
+#: What a warm start from the ``oracle`` (pose pairs or DAgger) gives a policy beyond pixels.
+ORACLE_DEMONSTRATIONS = "oracle demonstrations (true poses) in training"
+
+
+def privileged_training(config: dict[str, Any]) -> str:
+    """What beyond pixels a ``homing-train`` run with ``config`` (its ``config.yml``)
+    trained on: :data:`ORACLE_DEMONSTRATIONS` with a pose-pair or DAgger warm start, else
+    "" (a run started from another's network, ``init_policy``, is not traced)."""
+    warm = config.get("pretrain_samples") or config.get("imitation_iterations")
+    return ORACLE_DEMONSTRATIONS if warm else ""
 
 
 def eval_env_kwargs(train_env_kwargs: dict[str, Any]) -> dict[str, Any]:
@@ -98,7 +112,7 @@ def recorded_settings(zip_path: str) -> RecordedSettings:
         except yaml.YAMLError as err:
             raise ValueError(f"{run_config}: not readable YAML ({err})") from None
         return RecordedSettings(eval_env_kwargs(dict(config.get("env_kwargs") or {})), {},
-                                config.get("env_id"), run_config)
+                                config.get("env_id"), run_config, privileged_training(config))
     if not os.path.isfile(meta_path):
         return RecordedSettings()
     try:
@@ -106,7 +120,8 @@ def recorded_settings(zip_path: str) -> RecordedSettings:
     except yaml.YAMLError as err:
         raise ValueError(f"{meta_path}: not readable YAML ({err})") from None
     return RecordedSettings(dict(meta.get("eval_env_kwargs") or {}),
-                            dict(meta.get("eval_params") or {}), meta.get("env_id"), meta_path)
+                            dict(meta.get("eval_params") or {}), meta.get("env_id"), meta_path,
+                            str(meta.get("privileged") or ""))
 
 
 def policy_spec(policy: str | Controller | PolicySpec,
@@ -256,6 +271,7 @@ class ShippedPolicy:
     env_kwargs: dict
     params: dict    # SB3 policy parameters, e.g. {"deterministic": False}
     env_id: str | None = None   # the env it was trained on (None: any)
+    privileged: str = ""        # what beyond pixels its training used ("" if nothing)
 
 
 def shipped_policies(folder: Path = POLICY_DIR) -> dict[str, ShippedPolicy]:
@@ -265,5 +281,5 @@ def shipped_policies(folder: Path = POLICY_DIR) -> dict[str, ShippedPolicy]:
     for model in sorted(folder.glob("*.zip")):
         settings = recorded_settings(str(model))
         found[model.stem] = ShippedPolicy(model, settings.env_kwargs, settings.params,
-                                          settings.env_id)
+                                          settings.env_id, settings.privileged)
     return found

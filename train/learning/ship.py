@@ -8,7 +8,9 @@ ships ``model.zip`` or the network as the warm start left it),
 ``<name>.yml`` (the run's config, command, timesteps and wall time, and the
 ``eval_env_kwargs`` that ``homing-suite`` evaluates it with: the training env kwargs
 without the training ``scene``, so the policy is scored in the env's default scene; and
-``eval_params``: ``deterministic``, false with ``--stochastic``) and
+``eval_params``: ``deterministic``, false with ``--stochastic``; ``privileged``: what
+beyond pixels the training used, ``--privileged`` or derived from the run's warm starts,
+named beside the policy in the methods x protocols matrix) and
 ``<name>_curve.png`` (the run's learning curve).
 """
 
@@ -22,7 +24,7 @@ from pathlib import Path
 import yaml
 
 from homing_gym.cli import command_parser
-from homing_train.harness.policies import POLICY_DIR, eval_env_kwargs
+from homing_train.harness.policies import POLICY_DIR, eval_env_kwargs, privileged_training
 
 MAX_BYTES = 10 * 2**20
 #: ``--model`` choices: the run folder's model files.
@@ -38,11 +40,14 @@ class _PlainDumper(yaml.SafeDumper):
 
 
 def ship_run(run: Path, name: str, folder: Path = POLICY_DIR, model: str = "best",
-             stochastic: bool = False, why: str | None = None) -> Path:
+             stochastic: bool = False, why: str | None = None,
+             privileged: str | None = None) -> Path:
     """Copy ``model`` (a key of :data:`MODELS`) of run ``run`` into ``folder`` as ``name``;
     returns the shipped zip's path. ``stochastic``: evaluate it by sampling actions
     (``eval_params: {deterministic: false}``) instead of taking the distribution's mode.
-    ``why``: how the model was chosen, recorded in the ``.yml``."""
+    ``why``: how the model was chosen, recorded in the ``.yml``; ``privileged``: what
+    beyond pixels the training used (default: :func:`privileged_training` of the run's
+    config, e.g. the oracle's demonstrations of a warm start)."""
     if model not in MODELS:
         raise ValueError(f"unknown model {model!r}; allowed: {list(MODELS)}")
     path = run / MODELS[model]
@@ -58,6 +63,7 @@ def ship_run(run: Path, name: str, folder: Path = POLICY_DIR, model: str = "best
         "env_id": config["env_id"],
         "eval_env_kwargs": eval_env_kwargs(config["env_kwargs"]),
         "eval_params": {"deterministic": not stochastic},
+        "privileged": privileged_training(config) if privileged is None else privileged,
         "model": MODELS[model],
         "chosen": why or ("best evaluation-callback return on held-out training seeds"
                           if model == "best" else f"the run's {MODELS[model]}"),
@@ -89,10 +95,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--why", help="how the model was chosen (recorded in the .yml)")
     parser.add_argument("--stochastic", action="store_true",
                         help="evaluate the shipped policy with sampled actions")
+    parser.add_argument("--privileged",
+                        help="what beyond pixels the training used (default: the oracle's "
+                             "demonstrations if the run had a warm start, else none)")
     args = parser.parse_args(argv)
     try:
         target = ship_run(args.run, args.name, model=args.model, stochastic=args.stochastic,
-                          why=args.why)
+                          why=args.why, privileged=args.privileged)
     except ValueError as err:
         parser.exit(2, f"ship: error: {err}\n")
     print(f"shipped {target}")

@@ -119,9 +119,13 @@ class TrainConfig:
             if not scenes or not all(isinstance(name, str) for name in scenes):
                 raise ValueError(f"env_kwargs scene: a scene name or a non-empty list of "
                                  f"scene names, got {scenes!r}")
-            if self.pretrain_samples or self.imitation_iterations:
-                raise ValueError("a list of scenes is for PPO's envs; pretraining and DAgger "
-                                 "take one scene (env_kwargs scene: NAME)")
+            if self.imitation_iterations:
+                raise ValueError("a list of scenes is for PPO's envs and pretraining; DAgger "
+                                 "takes one scene (env_kwargs scene: NAME)")
+            if self.pretrain_samples and self.pretrain_scenes < len(scenes):
+                raise ValueError(f"pretraining on {len(scenes)} scenes needs pretrain_scenes "
+                                 f">= {len(scenes)} (instance s builds scene[s % "
+                                 f"{len(scenes)}]), got {self.pretrain_scenes}")
 
     def env_kwargs_of(self, rank: int) -> dict:
         """The env kwargs of vector env ``rank``: with a list of scenes, env ``rank``

@@ -144,6 +144,7 @@ def test_a_run_folders_model_runs_a_protocol_with_its_training_env_kwargs(tmp_pa
     assert setting["env_kwargs"]["panorama_shape"] == [16, 64]
     assert setting["env_kwargs"]["scene"] == "arena"
     assert setting["env_kwargs"]["success_on"] == "stop"
+    assert cell.privileged == ""                # no warm start from the oracle
     with pytest.raises(ValueError, match="or a PPO model .zip"):
         run_cell(protocol("yukim"), str(tmp_path / "missing.zip"), tmp_path / "x")
 
@@ -163,12 +164,14 @@ def test_matrix_files_name_every_cell_with_its_command(tmp_path):
                "reached_rate": 0.5, "reached_ci": [0.2, 0.8], "spl": 0.25,
                "final_distance_mean": 0.42}
     cells = [Cell("yukim", 1, m, f"homing-eval --protocol yukim --policy {m} --out OUT.json",
-                  summary, {}) for m in ("warping", "distance")]
+                  summary, {}, privileged) for m, privileged in
+             (("warping", ""), ("distance", ""), ("cloned", "oracle demonstrations"))]
     written = write_matrix(cells, tmp_path)
     text = open(written["md"]).read()
     assert "| warping | 30 [10, 60] |" in text
+    assert "| cloned (privileged: oracle demonstrations) | 30 [10, 60] |" in text
     assert "`homing-eval --protocol yukim --policy distance --out OUT.json`" in text
-    assert open(written["csv"]).read().count("\n") == 3
+    assert open(written["csv"]).read().count("\n") == 4
     assert open(written["png"], "rb").read(4) == b"\x89PNG"
 
 

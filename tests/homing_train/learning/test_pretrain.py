@@ -147,3 +147,37 @@ def test_critic_warmup_leaves_the_actor_unchanged(tmp_path):
     assert critic and any(not torch.equal(before[k], after[k]) for k in critic)
     for key in set(before) - set(critic):
         assert torch.equal(before[key], after[key]), key
+
+
+def test_a_bank_over_a_list_of_scenes_labels_near_pairs_stop():
+    """Instance s of a bank over [random_rooms, random_nature] is scene s % 2 with its own
+    world; with near positions (success_on="stop") entry 2k + 1 lies within ``near`` of
+    2k, and exactly the near pairs closer than the stop radius are labelled stop."""
+    from homing_baselines.motion import STOP
+    from homing_train.learning.pretrain import STOP_SHARE, joined, near_pairs
+
+    kwargs = {**KWARGS, "success_on": "stop"}
+    envs = [gym.make("homing_gym/LocalHoming-v0", **{**kwargs, "scene": name})
+            for name in ("random_rooms", "random_nature")]
+    oracle = homing_baselines.make("oracle")
+    prepare_policy(oracle, envs[0])
+    helper = MotionHelper(oracle.motion_spec, oracle.motion)
+    bank = render_bank(envs, 6, 4, seed=5, near=0.3, progress=False)
+    for env in envs:
+        env.close()
+    assert [w.name for w in bank.scenes] == ["random_rooms", "random_nature"] * 2
+    assert bank.scenes[0] is not bank.scenes[2]
+    assert bank.scene_index.tolist() == np.repeat(np.arange(4), 6).tolist()
+    gaps = np.linalg.norm(bank.positions[1::2] - bank.positions[::2], axis=1)
+    assert np.all(gaps <= 0.3) and np.all(gaps > 0)
+    with pytest.raises(ValueError, match="even number"):
+        render_bank(envs[:1], 5, 1, seed=0, near=0.3, progress=False)
+    rng = np.random.default_rng(1)
+    pairs = joined(pair_set(bank, 20, (0.15, 1.5), oracle, rng, progress=False),
+                   near_pairs(bank, oracle))
+    radius = STOP_SHARE * 0.15
+    p = np.arange(len(pairs.current))
+    labels = pair_labels(bank, pairs, p, np.zeros_like(p), oracle, helper, radius)
+    d = np.linalg.norm(bank.positions[pairs.current] - bank.positions[pairs.home], axis=1)
+    assert np.array_equal(labels == STOP, d < radius)
+    assert 0 < np.sum(d < radius) < len(d)

@@ -155,6 +155,7 @@ def test_suite_evaluates_and_compares_methods_on_one_suite(tmp_path, capsys):
 
 
 def test_ship_copies_the_best_model_with_eval_settings_and_curve(tmp_path):
+    from homing_train.harness.policies import ORACLE_DEMONSTRATIONS, shipped_policies
     from homing_train.learning.ship import ship_run
 
     run = tmp_path / "run"
@@ -175,6 +176,7 @@ def test_ship_copies_the_best_model_with_eval_settings_and_curve(tmp_path):
     assert meta["eval_env_kwargs"] == {"action_type": "discrete"}
     assert meta["eval_params"] == {"deterministic": True}
     assert meta["timesteps"] == 1000 and meta["commands"] == ["homing-train --seed 3"]
+    assert meta["privileged"] == ""
     assert (shipped / "p_curve.png").read_bytes() == b"png"
     assert ship_run(run, "q", shipped, model="final", stochastic=True).read_bytes() == b"final"
     meta = yaml.safe_load((shipped / "q.yml").read_text())
@@ -183,6 +185,13 @@ def test_ship_copies_the_best_model_with_eval_settings_and_curve(tmp_path):
         ship_run(run, "s", shipped, model="pretrain")
     with pytest.raises(ValueError, match="unknown model"):
         ship_run(run, "t", shipped, model="latest")
+    ship_run(run, "u", shipped, privileged="odometry")
+    assert yaml.safe_load((shipped / "u.yml").read_text())["privileged"] == "odometry"
+    (run / "config.yml").write_text(yaml.safe_dump({
+        "env_id": "homing_gym/LocalHoming-v0", "env_kwargs": {}, "pretrain_samples": 8}))
+    ship_run(run, "v", shipped)
+    assert yaml.safe_load((shipped / "v.yml").read_text())["privileged"] == ORACLE_DEMONSTRATIONS
+    assert shipped_policies(shipped)["v"].privileged == ORACLE_DEMONSTRATIONS
     (run / "summary.json").unlink()
     with pytest.raises(ValueError, match="summary.json"):
         ship_run(run, "r", shipped)
@@ -375,6 +384,10 @@ def test_a_list_of_scenes_gives_each_env_its_own_and_bad_lists_are_refused():
     for bad in ([], ["random_rooms", 3]):
         with pytest.raises(ValueError, match="list of scene names"):
             TrainConfig("homing_gym/LocalHoming-v0", env_kwargs={"scene": bad})
-    with pytest.raises(ValueError, match="pretraining and DAgger take one scene"):
-        TrainConfig("homing_gym/LocalHoming-v0", pretrain_samples=10,
-                    env_kwargs={"scene": ["random_rooms", "random_nature"]})
+    both = {"scene": ["random_rooms", "random_nature"]}
+    with pytest.raises(ValueError, match="DAgger takes one scene"):
+        TrainConfig("homing_gym/LocalHoming-v0", imitation_iterations=1, env_kwargs=both)
+    with pytest.raises(ValueError, match="needs pretrain_scenes >= 2"):
+        TrainConfig("homing_gym/LocalHoming-v0", pretrain_samples=10, env_kwargs=both)
+    TrainConfig("homing_gym/LocalHoming-v0", pretrain_samples=10, pretrain_scenes=2,
+                env_kwargs=both)
