@@ -20,6 +20,7 @@ COMMANDS = {
     "python -m homing_train.figures.selfsimilar": "homing_train.figures.selfsimilar",
     "python -m homing_train.figures.multires": "homing_train.figures.multires",
     "python -m homing_train.figures.renderers": "homing_train.figures.renderers",
+    "python -m homing_train.figures.generalisation": "homing_train.figures.generalisation",
     "python -m homing_train.learning.ship": "homing_train.learning.ship",
     "python -m homing_train.learning.rllib_ppo": "homing_train.learning.rllib_ppo",
     "python -m homing_gym.envcard": "homing_gym.envcard",

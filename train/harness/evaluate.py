@@ -79,7 +79,13 @@ class EvalResult:
     def __post_init__(self) -> None:
         if not self.summary:
             self.summary = summarize(self.episodes, self.bin_width, seed=self.seed,
-                                     radius=float(self.env_kwargs.get("success_radius", 0.15)))
+                                     radius=self.success_radius)
+
+    @property
+    def success_radius(self) -> float:
+        """The episodes' success radius (metres): the env's ``success_radius``, else the
+        tasks' default 0.15."""
+        return float(self.env_kwargs.get("success_radius", 0.15))
 
     def to_dict(self) -> dict[str, Any]:
         return {"schema": SCHEMA, "policy": self.policy, "params": self.params,

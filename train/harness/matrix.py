@@ -108,8 +108,10 @@ def equal_time_kwargs(setting_kwargs: dict, recorded: dict) -> dict:
     return merged
 
 
-def _slug(text: str) -> str:
-    return re.sub(r"[^a-z0-9]+", "_", text.lower()).strip("_")
+def setting_stem(label: str) -> str:
+    """The file stem of a setting's results in a cell's folder (``hallway (held out)`` ->
+    ``hallway_held_out``)."""
+    return re.sub(r"[^a-z0-9]+", "_", label.lower()).strip("_")
 
 
 def run_cell(protocol: Protocol, method: str, out: Path, episodes: int | None = None,
@@ -141,7 +143,7 @@ def run_cell(protocol: Protocol, method: str, out: Path, episodes: int | None = 
             kwargs = equal_time_kwargs(kwargs, shipped[method].env_kwargs)
         else:
             policy, params = method, {}
-        stem = out / _slug(setting.label)
+        stem = out / setting_stem(setting.label)
         result = evaluate(policy, setting.env_id, env_kwargs=kwargs, workers=workers,
                           params=params, progress=progress,
                           stream=f"{stem}.episodes.jsonl", resume=resume,

@@ -1,0 +1,64 @@
+"""The per-scene generalisation figure reads a protocol folder as homing-suite writes it."""
+
+import json
+
+import imageio.v2 as imageio
+import numpy as np
+import pytest
+
+from homing_train.figures.generalisation import (TILE, failures_figure, load_results,
+                                                 per_scene_markdown)
+from homing_train.harness.evaluate import EpisodeRecord, EvalResult
+from homing_train.harness.matrix import setting_stem
+
+
+def _episode(seed: int, success: bool) -> EpisodeRecord:
+    return EpisodeRecord(seed=seed, start_pose=[0.5, 0.0, 0.0], home_pose=[-0.5, 0.0, 0.0],
+                         start_distance=1.0, shortest_path=1.0, success=success,
+                         terminated=True, truncated=False, steps=10, path_length=1.0,
+                         final_distance=0.05 if success else 0.6, min_distance=0.05,
+                         collisions=0, spl=float(success), soft_spl=0.5,
+                         final_heading_error_deg=0.0, wall_time=0.1,
+                         trajectory=[[0.5, 0.0], [0.2, 0.1], [-0.1, 0.2]])
+
+
+def _write_cell(folder, method: str, outcomes: dict[str, list[bool]]) -> None:
+    """A method's cell as run_cell writes it: one result JSON per setting, cell.json."""
+    cell = folder / method
+    cell.mkdir(parents=True)
+    for label, successes in outcomes.items():
+        EvalResult(method, {}, "homing_gym/LocalHoming-v0", {"scene": "arena"}, 0,
+                   [_episode(s, ok) for s, ok in enumerate(successes)]).save(
+            str(cell / f"{setting_stem(label)}.json"))
+    (cell / "cell.json").write_text(json.dumps({"method": method, "settings": {
+        label: {"episodes": len(v)} for label, v in outcomes.items()}}))
+
+
+def test_per_scene_table_counts_successes_with_wilson_intervals(tmp_path):
+    _write_cell(tmp_path, "warping", {"arena (held out)": [True, False],
+                                      "lab (held out)": [True, True]})
+    _write_cell(tmp_path, "snapshot", {"arena (held out)": [False, False],
+                                       "lab (held out)": [True, False]})
+    results = load_results(tmp_path)
+    assert [r.label for r in results["warping"]] == ["arena (held out)", "lab (held out)"]
+    table = per_scene_markdown(results).splitlines()
+    # 1 of 2: Wilson 95 % = 0.5 +- 1.96 sqrt(0.125 + 0.2401) / 2.9208 = [0.09, 0.91]
+    assert "| warping | 50 [9, 91] (2) | 100 [34, 100] (2) |" in table
+    assert "| snapshot | 0 [0, 66] (2) | 50 [9, 91] (2) |" in table
+
+
+def test_failures_figure_has_a_row_per_method_that_failed(tmp_path):
+    _write_cell(tmp_path / "cells", "oracle", {"arena": [True, True]})
+    _write_cell(tmp_path / "cells", "warping", {"arena": [True, False]})
+    _write_cell(tmp_path / "cells", "snapshot", {"arena": [False, False]})
+    results = load_results(tmp_path / "cells")
+    failures_figure(results, tmp_path / "failures.png")
+    image = imageio.imread(tmp_path / "failures.png")
+    one_row = TILE + 22                                           # a tile under its label bar
+    assert image.shape[0] == 2 * one_row                          # the oracle never failed
+    assert np.ptp(image) > 0
+
+
+def test_an_empty_folder_is_refused(tmp_path):
+    with pytest.raises(ValueError, match="cell.json"):
+        load_results(tmp_path)
