@@ -101,3 +101,12 @@ def test_generic_top_level_names_are_not_installed(tmp_path):
     out = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
                          text=True, check=True, timeout=60)
     assert out.stdout.strip() == "[] []"
+
+
+def test_the_rllib_command_imports_without_stable_baselines3():
+    """.ci/rllib's environment has RLlib but not the [train] extra: the RLlib module (and
+    what it imports of homing-train's) must import with stable-baselines3 absent."""
+    code = ("import sys; sys.modules['stable_baselines3'] = None; "
+            "import homing_train.learning.rllib_ppo")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr

@@ -10,19 +10,19 @@ successes (``is_success`` of the episode's last step, as SB3's ``Monitor`` recor
 training env moves to the next stage (``env_method("set_start_distance", ...)``, e.g.
 :meth:`homing_gym.envs.LocalHomingEnv.set_start_distance`) and the window starts empty.
 The evaluation envs are not touched: they keep ``env_kwargs``' ``start_distance``.
+The callback that does it is :class:`~homing_train.learning.curriculum_callback.CurriculumCallback`
+(apart, so that this module imports without stable-baselines3, as ``train.py`` does).
 """
 
 from __future__ import annotations
 
 import json
 import math
-from collections import deque
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from stable_baselines3.common.callbacks import BaseCallback
 
 #: the env method a curriculum calls on every training env
 HOOK = "set_start_distance"
@@ -70,64 +70,6 @@ class CurriculumSettings:
                              f"{window!r}")
         return cls(tuple((float(lo), float(hi)) for lo, hi in stages), float(promote_at),
                    window)
-
-
-class CurriculumCallback(BaseCallback):
-    """Moves the training envs through the stages of ``settings`` (see the module).
-
-    Logs ``curriculum/stage``, ``curriculum/success_rate`` (over the current window) and
-    ``curriculum/max_start_distance`` (m) with every rollout, and writes the stages
-    reached, with the env step of each, to ``path`` (JSON). ``stage``: the stage to start
-    from (a resumed run's last one, :func:`last_stage`)."""
-
-    def __init__(self, settings: CurriculumSettings, path: Path, stage: int = 0,
-                 history: list[dict] | None = None):
-        super().__init__()
-        if not 0 <= stage < len(settings.start_distance):
-            raise ValueError(f"curriculum stage {stage} does not exist; stages 0 to "
-                             f"{len(settings.start_distance) - 1}")
-        self.settings = settings
-        self.path = Path(path)
-        self.stage = stage
-        self.history = list(history or [])
-        self.outcomes: deque[bool] = deque(maxlen=settings.window)
-
-    @property
-    def success_rate(self) -> float:
-        """Success rate of the episodes in the current window (nan while empty)."""
-        return sum(self.outcomes) / len(self.outcomes) if self.outcomes else math.nan
-
-    def _enter(self, stage: int) -> None:
-        self.stage = stage
-        self.outcomes.clear()
-        self.training_env.env_method(HOOK, self.settings.start_distance[stage])
-        if not self.history or self.history[-1]["stage"] != stage:
-            self.history.append({"stage": stage,
-                                 "start_distance": list(self.settings.start_distance[stage]),
-                                 "from_step": int(self.num_timesteps)})
-        self.path.write_text(json.dumps({"settings": {
-            "start_distance": [list(s) for s in self.settings.start_distance],
-            "promote_at": self.settings.promote_at, "window": self.settings.window},
-            "stages": self.history}, indent=2))
-
-    def _on_training_start(self) -> None:
-        self._enter(self.stage)
-
-    def _on_step(self) -> bool:
-        for info in self.locals["infos"]:
-            if "episode" in info:           # Monitor's record of a finished episode
-                self.outcomes.append(bool(info["episode"]["is_success"]))
-        last = len(self.settings.start_distance) - 1
-        if (self.stage < last and len(self.outcomes) == self.settings.window
-                and self.success_rate >= self.settings.promote_at):
-            self._enter(self.stage + 1)
-        return True
-
-    def _on_rollout_end(self) -> None:
-        self.logger.record("curriculum/stage", self.stage)
-        self.logger.record("curriculum/success_rate", self.success_rate)
-        self.logger.record("curriculum/max_start_distance",
-                           self.settings.start_distance[self.stage][1])
 
 
 def last_stage(path: Path) -> tuple[int, list[dict]]:

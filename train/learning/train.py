@@ -42,8 +42,8 @@ import homing_gym
 from homing_gym.cli import command_parser
 from homing_train.extras import MissingExtraError, require_extra
 from homing_train.learning import EXTRACTORS
-from homing_train.learning.curriculum import (HOOK, CurriculumCallback, CurriculumSettings,
-                                              last_stage, mark_stages, plot_training_success)
+from homing_train.learning.curriculum import (HOOK, CurriculumSettings, last_stage, mark_stages,
+                                              plot_training_success)
 from homing_train.learning.imitation import dagger
 from homing_train.learning.ppo_settings import PPO_KEYS, check_ppo, ppo_arguments
 from homing_train.learning.pretrain import pretrain
@@ -441,8 +441,9 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
     """Train (or, with ``resume``, continue) a run in folder ``out``; returns the model."""
     from stable_baselines3 import PPO
     from stable_baselines3.common.callbacks import CheckpointCallback, EvalCallback
-
     import torch
+
+    from homing_train.learning.curriculum_callback import CurriculumCallback
 
     # One intra-op thread by default: with the env workers on the same cores, torch's
     # thread pool spins against them and learn() ran 4x slower on 2 cores (docs/training.md).

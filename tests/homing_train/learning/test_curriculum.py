@@ -8,7 +8,8 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from homing_train.learning.curriculum import CurriculumCallback, CurriculumSettings, last_stage
+from homing_train.learning.curriculum import CurriculumSettings, last_stage
+from homing_train.learning.curriculum_callback import CurriculumCallback
 from homing_train.learning.train import check_curriculum, main, make_config, make_monitored_env
 
 STAGES = [[0.15, 0.35], [0.2, 0.6], [0.3, 1.5]]
