@@ -2,4 +2,4 @@
 the oracle, feature extractors, and shipping a trained policy with its record."""
 
 #: Names of the features extractors (:mod:`homing_train.learning.extractor`).
-EXTRACTORS = ("panorama", "band", "combined")
+EXTRACTORS = ("panorama", "band", "align", "combined")

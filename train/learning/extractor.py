@@ -13,6 +13,13 @@ one linear layer (about 8 M multiply-adds per 48 x 256 sample).
 it treats the rows of a low panorama (a band around the horizon, e.g. 16 x 128) as
 channels and runs 1-D circular convolutions over azimuth only (about 1.5 M multiply-adds
 per 16 x 128 sample with the default layers).
+
+:class:`AlignedBandExtractor` (``"align"``) aligns the goal to the current view before
+comparing them: one shared encoder maps each panorama to per-column features, their
+circular cross-correlation over every relative rotation gives a soft visual compass, the
+goal's features are rotated by it into the robot's frame, and a head compares the two
+column by column. Its output is layer-normalised, so that PPO's tanh layers behind it do
+not saturate (see docs/training.md, "Saturated features").
 """
 
 from __future__ import annotations
@@ -124,13 +131,101 @@ class HorizonBandExtractor(PanoramaGoalExtractor):
         return torch.cat([observations[k].flatten(1, 2) for k in self.image_keys], dim=1)
 
 
+class AlignedBandExtractor(BaseFeaturesExtractor):
+    """Compare the goal with the current panorama after rotating it into the robot's frame.
+
+    Both images, ``(C, H, W)`` with azimuth along ``W``, are standardised (zero mean, unit
+    variance over each image: lighting offsets drop out) and go through one shared
+    encoder of 1-D circular convolutions over azimuth with the ``C * H`` rows as channels,
+    at full width: per-column features ``f`` and ``g``, each column scaled to unit
+    length. Their circular cross-correlation ``r(s) = mean_theta <f(theta), g(theta - s)>``
+    over all ``W`` shifts (by FFT) is the rotational similarity that a visual compass
+    searches; ``p = softmax(temperature * r)`` (temperature learned) weights the shifts,
+    and ``g_al = sum_s p(s) g(. - s)`` is the goal's features rotated into the current
+    frame. The head runs circular convolutions over ``[f, g_al, f - g_al]`` (the
+    difference holds the parallax, whose pattern over azimuth points home), flattens
+    them with ``p`` (the heading offset), and a linear layer and LayerNorm give
+    ``features_dim`` values. Other keys are flattened and appended, as in
+    :class:`PanoramaGoalExtractor`. ``encoder`` and ``head``: (channels, kernel, stride)
+    of each convolution; the encoder's strides must be 1 (one column per shift)."""
+
+    def __init__(self, observation_space: gym.spaces.Dict, features_dim: int = 128,
+                 image_keys: tuple[str, str] = ("panorama", "goal"),
+                 encoder: tuple[tuple[int, int, int], ...] = ((32, 5, 1), (32, 5, 1)),
+                 head: tuple[tuple[int, int, int], ...] = ((64, 5, 2), (64, 3, 2)),
+                 temperature: float = 20.0):
+        if len(image_keys) != 2:
+            raise ValueError(f"{type(self).__name__} compares two images (current, goal); "
+                             f"got image_keys {image_keys}")
+        shapes = {observation_space[k].shape for k in image_keys
+                  if k in observation_space.spaces}
+        if len(shapes) != 1 or not all(k in observation_space.spaces for k in image_keys):
+            raise ValueError(f"{type(self).__name__} needs observation keys {image_keys} "
+                             f"of one shape; the space has {observation_space}")
+        if any(stride != 1 for _, _, stride in encoder):
+            raise ValueError(f"the encoder's strides must be 1 (one column per shift); got "
+                             f"{encoder}")
+        extra_keys = [k for k in observation_space.spaces if k not in image_keys]
+        extra_dim = sum(int(torch.tensor(observation_space[k].shape).prod()) for k in extra_keys)
+        super().__init__(observation_space, features_dim + extra_dim)
+        channels, rows, width = observation_space[image_keys[0]].shape
+        self.image_keys = tuple(image_keys)
+        self.extra_keys = tuple(extra_keys)
+        self.encoder = self._convs(channels * rows, encoder)
+        self.head = nn.Sequential(self._convs(3 * encoder[-1][0], head), nn.Flatten())
+        with torch.no_grad():
+            n_flat = self.head(torch.zeros(1, 3 * encoder[-1][0], width)).shape[1]
+        self.log_temperature = nn.Parameter(torch.tensor(float(temperature)).log())
+        self.linear = nn.Sequential(nn.Linear(n_flat + width, features_dim),
+                                    nn.LayerNorm(features_dim))
+
+    @staticmethod
+    def _convs(c_in: int, layers: tuple[tuple[int, int, int], ...]) -> nn.Sequential:
+        convs = []
+        for c_out, kernel, stride in layers:
+            convs.append(CircularConv1d(c_in, c_out, kernel, stride))
+            c_in = c_out
+        return nn.Sequential(*convs)
+
+    def column_features(self, image: torch.Tensor) -> torch.Tensor:
+        """Unit-length per-column features ``(N, K, W)`` of standardised ``(N, C, H, W)``
+        images."""
+        flat = image.flatten(1, 2)
+        mean = flat.mean(dim=(1, 2), keepdim=True)
+        std = flat.std(dim=(1, 2), keepdim=True)
+        return F.normalize(self.encoder((flat - mean) / (std + 1e-3)), dim=1)
+
+    def shift_weights(self, f: torch.Tensor, g: torch.Tensor) -> torch.Tensor:
+        """``p(s)``, ``(N, W)``: softmax over shifts ``s`` (columns, counter-clockwise
+        as the panorama's columns run) of the correlation ``mean_theta <f(theta),
+        g(theta - s)>``."""
+        width = f.shape[-1]
+        spectrum = torch.fft.rfft(f, dim=-1) * torch.fft.rfft(g, dim=-1).conj()
+        correlation = torch.fft.irfft(spectrum.sum(dim=1), n=width, dim=-1) / width
+        return torch.softmax(self.log_temperature.exp() * correlation, dim=-1)
+
+    def forward(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
+        current, goal = (observations[k] for k in self.image_keys)
+        f, g = self.column_features(current), self.column_features(goal)
+        p = self.shift_weights(f, g)
+        width = f.shape[-1]
+        aligned = torch.fft.irfft(torch.fft.rfft(g, dim=-1)
+                                  * torch.fft.rfft(p, dim=-1).unsqueeze(1), n=width, dim=-1)
+        compared = self.head(torch.cat([f, aligned, f - aligned], dim=1))
+        features = [self.linear(torch.cat([compared, p], dim=1))]
+        features += [observations[k].flatten(1) for k in self.extra_keys]
+        return torch.cat(features, dim=1)
+
+
 def policy_kwargs_for(extractor: str, **extractor_kwargs) -> dict:
     """``policy_kwargs`` for ``PPO("MultiInputPolicy", ...)``: ``"panorama"`` uses
     :class:`PanoramaGoalExtractor`, ``"band"`` :class:`HorizonBandExtractor`,
-    ``"combined"`` SB3's default ``CombinedExtractor``."""
+    ``"align"`` :class:`AlignedBandExtractor`, ``"combined"`` SB3's default
+    ``CombinedExtractor``."""
     if extractor not in EXTRACTORS:
         raise ValueError(f"unknown extractor {extractor!r}; allowed: {EXTRACTORS}")
     if extractor == "combined":
         return {}
-    cls = HorizonBandExtractor if extractor == "band" else PanoramaGoalExtractor
+    cls = {"panorama": PanoramaGoalExtractor, "band": HorizonBandExtractor,
+           "align": AlignedBandExtractor}[extractor]
     return {"features_extractor_class": cls, "features_extractor_kwargs": extractor_kwargs}

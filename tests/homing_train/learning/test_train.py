@@ -7,8 +7,8 @@ import pytest
 import torch
 import yaml
 
-from homing_train.learning.extractor import (CircularConv, CircularConv1d, HorizonBandExtractor,
-                                             PanoramaGoalExtractor)
+from homing_train.learning.extractor import (AlignedBandExtractor, CircularConv, CircularConv1d,
+                                             HorizonBandExtractor, PanoramaGoalExtractor)
 from homing_train.learning.train import latest_checkpoint, load_hyperparams, main, make_config, parse_overrides
 
 # 36 rows: the smallest height SB3's NatureCNN (inside CombinedExtractor) accepts
@@ -19,7 +19,7 @@ TINY = ["--env-kwargs", json.dumps({"panorama_shape": [36, 64], "max_episode_ste
         "--hp", "features_dim=32"]
 
 
-@pytest.mark.parametrize("extractor", ["panorama", "band", "combined"])
+@pytest.mark.parametrize("extractor", ["panorama", "band", "align", "combined"])
 def test_smoke_run_writes_a_complete_run_folder(tmp_path, extractor):
     run = tmp_path / extractor
     main(["--timesteps", "256", "--extractor", extractor, "--out", str(run), *TINY])
@@ -139,6 +139,41 @@ def test_extractor_fuses_current_and_goal_early():
     assert out.shape == (2, 35)
     with pytest.raises(ValueError, match="goal"):
         PanoramaGoalExtractor(gym.spaces.Dict({"panorama": space["panorama"]}))
+
+
+def test_aligned_extractor_rotates_the_goal_into_the_current_frame():
+    import gymnasium as gym
+
+    torch.manual_seed(0)
+    space = gym.spaces.Dict({
+        "panorama": gym.spaces.Box(0, 255, (3, 8, 64), np.uint8),
+        "goal": gym.spaces.Box(0, 255, (3, 8, 64), np.uint8),
+        "odometry": gym.spaces.Box(-np.inf, np.inf, (3,), np.float32)})
+    extractor = AlignedBandExtractor(space, features_dim=16, temperature=500.0)
+    goal = torch.rand(3, 3, 8, 64)
+    shifts = [0, 9, 50]
+    current = torch.stack([torch.roll(g, k, dims=-1) for g, k in zip(goal, shifts)])
+    f, g = extractor.column_features(current), extractor.column_features(goal)
+    weights = extractor.shift_weights(f, g)
+    # the robot turned by k columns: the weight sits on shift k, nowhere else
+    assert weights.argmax(dim=1).tolist() == shifts
+    assert torch.all(weights.max(dim=1).values > 0.99)
+    # a view rotated by k columns leaves the same weights, rolled by k
+    turned = extractor.shift_weights(torch.roll(f, 4, dims=-1), g)
+    assert torch.allclose(turned, torch.roll(weights, 4, dims=-1), atol=1e-5)
+    out = extractor({"panorama": current, "goal": goal, "odometry": torch.rand(3, 3)})
+    assert out.shape == (3, 19)
+    # layer-normalised features: zero mean, unit variance per sample
+    assert torch.allclose(out[:, :16].mean(dim=1), torch.zeros(3), atol=1e-5)
+    assert torch.allclose(out[:, :16].std(dim=1, unbiased=False), torch.ones(3), atol=0.02)
+    # lighting offsets and gains drop out of the comparison
+    brighter = extractor({"panorama": 0.5 * current + 0.2, "goal": goal,
+                          "odometry": torch.zeros(3, 3)})
+    assert torch.allclose(brighter[:, :16], out[:, :16], atol=1e-3)
+    with pytest.raises(ValueError, match="strides must be 1"):
+        AlignedBandExtractor(space, encoder=((8, 5, 2),))
+    with pytest.raises(ValueError, match="goal"):
+        AlignedBandExtractor(gym.spaces.Dict({"panorama": space["panorama"]}))
 
 
 def test_suite_evaluates_and_compares_methods_on_one_suite(tmp_path, capsys):
