@@ -62,6 +62,7 @@ def _extractor_classes() -> dict[str, type]:
 
     from homing_train.learning import extractor
     known = [extractor.PanoramaGoalExtractor, extractor.HorizonBandExtractor,
+             extractor.AlignedBandExtractor,
              torch_layers.CombinedExtractor,
              torch_layers.NatureCNN, torch_layers.FlattenExtractor]
     return {cls.__name__: cls for cls in known}
