@@ -23,6 +23,7 @@ COMMANDS = {
     "python -m homing_train.figures.generalisation": "homing_train.figures.generalisation",
     "python -m homing_train.learning.ship": "homing_train.learning.ship",
     "python -m homing_train.learning.rllib_ppo": "homing_train.learning.rllib_ppo",
+    "python -m homing_train.learning.saturation": "homing_train.learning.saturation",
     "python -m homing_gym.envcard": "homing_gym.envcard",
 }
 

@@ -45,3 +45,28 @@ def test_huge_first_layer_weights_saturate_it_and_flatten_the_outputs():
     assert first["mlp_extractor.policy_net.1"].spread < 1e-6
     assert report.action_spread < 1e-6 < fresh.action_spread
     assert report.value_spread < 1e-6 < fresh.value_spread
+
+
+def test_command_reports_a_saved_policy_on_env_observations(tmp_path, capsys):
+    import json
+
+    import gymnasium as gym
+    import pytest
+    from stable_baselines3 import PPO
+
+    import homing_gym  # noqa: F401  (registers the envs)
+    from homing_train.learning.extractor import policy_kwargs_for
+    from homing_train.learning.saturation import main
+
+    kwargs = {"panorama_shape": [8, 32], "action_type": "discrete"}
+    with gym.make("homing_gym/LocalHoming-v0", **kwargs) as env:
+        model = PPO("MultiInputPolicy", env, n_steps=64, device="cpu", seed=0,
+                    policy_kwargs=policy_kwargs_for("align", features_dim=16))
+        model.save(tmp_path / "m.zip")
+    assert main([str(tmp_path / "m.zip"), "--env-kwargs", json.dumps(kwargs),
+                 "--observations", "3"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("3 observations")
+    assert "| mlp_extractor.policy_net.1 |" in out and "| value |" in out
+    with pytest.raises(SystemExit):
+        main([str(tmp_path / "m.zip"), "--observations", "1"])
