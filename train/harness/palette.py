@@ -18,7 +18,10 @@ _HEX = {"black": "000000", "orange": "E69F00", "sky": "56B4E9", "green": "009E73
 _FIXED = {"oracle": "black", "random": "grey", "snapshot": "orange", "warping": "sky",
           "distance": "blue", "bearing": "purple", "bearing-basic": "rose",
           "bearing-complementary": "wine", "bearing-longrange": "indigo",
-          "selfsimilar": "olive", "multires": "teal"}
+          "selfsimilar": "olive", "multires": "teal",
+          # the shipped learned policies (train/shipped/)
+          "ppo_localhoming": "vermillion", "ppo_procedural_imitation": "green",
+          "ppo_procedural": "sand"}
 _SPARE = ("vermillion", "sand", "green")
 #: Marker colours of the maps (RGB 0-255), used by no method: home a dark navy ring, the
 #: start a light grey ring.
@@ -32,12 +35,10 @@ def _rgb(name: str) -> tuple[float, float, float]:
 
 
 def method_color(method: str) -> tuple[float, float, float]:
-    """The RGB colour (0-1) of ``method`` in every plot; learned policies (``ppo...``) in
-    vermillion."""
+    """The RGB colour (0-1) of ``method`` in every plot (fixed for the package's methods
+    and shipped policies, else chosen by a hash of the name)."""
     if method in _FIXED:
         return _rgb(_FIXED[method])
-    if method.startswith("ppo"):
-        return _rgb("vermillion")
     return _rgb(_SPARE[zlib.crc32(method.encode()) % len(_SPARE)])
 
 
