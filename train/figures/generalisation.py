@@ -145,12 +145,14 @@ def failure_tile(result: SceneResult) -> np.ndarray:
 def failures_figure(results: dict[str, list[SceneResult]], path: Path) -> None:
     """One row per method that failed anywhere (name on the left), one tile per scene."""
     rows = []
+    font, scale = cv2.FONT_HERSHEY_SIMPLEX, 0.5
+    width = 12 + max(cv2.getTextSize(m, font, scale, 1)[0][0] for m in results)
     for method, scene_results in results.items():
         if all(r.successes == len(r.episodes) for r in scene_results):
             continue
         tiles = np.concatenate([failure_tile(r) for r in scene_results], axis=1)
-        name = np.full((tiles.shape[0], 150, 3), BG, np.uint8)
-        cv2.putText(name, method, (6, tiles.shape[0] // 2), cv2.FONT_HERSHEY_SIMPLEX, 0.5,
+        name = np.full((tiles.shape[0], width, 3), BG, np.uint8)
+        cv2.putText(name, method, (6, tiles.shape[0] // 2), font, scale,
                     tuple(int(255 * c) for c in method_color(method)), 1, cv2.LINE_AA)
         rows.append(np.concatenate([name, tiles], axis=1))
     imageio.imwrite(path, np.concatenate(rows, axis=0))
