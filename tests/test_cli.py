@@ -21,6 +21,7 @@ COMMANDS = {
     "python -m homing_train.figures.multires": "homing_train.figures.multires",
     "python -m homing_train.figures.renderers": "homing_train.figures.renderers",
     "python -m homing_train.figures.generalisation": "homing_train.figures.generalisation",
+    "python -m homing_train.figures.checkpoints": "homing_train.figures.checkpoints",
     "python -m homing_train.learning.ship": "homing_train.learning.ship",
     "python -m homing_train.learning.rllib_ppo": "homing_train.learning.rllib_ppo",
     "python -m homing_train.learning.saturation": "homing_train.learning.saturation",

@@ -101,17 +101,23 @@ def eval_env_kwargs(train_env_kwargs: dict[str, Any]) -> dict[str, Any]:
 def recorded_settings(zip_path: str) -> RecordedSettings:
     """The evaluation settings recorded beside the policy zip ``zip_path``: its ``.yml``
     (a shipped policy), else the ``config.yml`` of the ``homing-train`` run folder it lies
-    in (:func:`eval_env_kwargs` of the training env kwargs)."""
+    in, directly or in its ``checkpoints/`` (:func:`eval_env_kwargs` of the training env
+    kwargs; sampled actions if the run's evaluations sampled them)."""
     import yaml
 
     meta_path = os.path.splitext(zip_path)[0] + ".yml"
-    run_config = os.path.join(os.path.dirname(zip_path), "config.yml")
+    folder = os.path.dirname(zip_path)
+    if os.path.basename(folder) == "checkpoints":
+        folder = os.path.dirname(folder)
+    run_config = os.path.join(folder, "config.yml")
     if not os.path.isfile(meta_path) and os.path.isfile(run_config):
         try:
             config = yaml.safe_load(open(run_config).read()) or {}
         except yaml.YAMLError as err:
             raise ValueError(f"{run_config}: not readable YAML ({err})") from None
-        return RecordedSettings(eval_env_kwargs(dict(config.get("env_kwargs") or {})), {},
+        params = ({"deterministic": False} if config.get("eval_deterministic") is False
+                  else {})
+        return RecordedSettings(eval_env_kwargs(dict(config.get("env_kwargs") or {})), params,
                                 config.get("env_id"), run_config, privileged_training(config))
     if not os.path.isfile(meta_path):
         return RecordedSettings()

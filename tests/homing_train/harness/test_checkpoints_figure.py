@@ -1,0 +1,30 @@
+"""Choosing a run's checkpoints and tabulating their scores (no episodes run)."""
+
+import pytest
+
+from homing_train.figures.checkpoints import (PRETRAIN_STEP, CheckpointScore, markdown,
+                                              run_checkpoints)
+
+
+def test_checkpoints_at_multiples_of_every_in_step_order_after_the_warm_start(tmp_path):
+    (tmp_path / "checkpoints").mkdir()
+    for steps in (100000, 25000, 50000, 75000):
+        (tmp_path / "checkpoints" / f"ppo_{steps}_steps.zip").write_bytes(b"")
+    (tmp_path / "checkpoints" / "notes.zip").write_bytes(b"")
+    chosen = run_checkpoints(tmp_path, every=50000)
+    assert [(s, p.name) for s, p in chosen] == [(50000, "ppo_50000_steps.zip"),
+                                                (100000, "ppo_100000_steps.zip")]
+    (tmp_path / "pretrain_model.zip").write_bytes(b"")
+    assert [s for s, _ in run_checkpoints(tmp_path, every=25000)] == [
+        PRETRAIN_STEP, 25000, 50000, 75000, 100000]
+    with pytest.raises(ValueError, match="no checkpoints at multiples of 30000"):
+        run_checkpoints(tmp_path / "checkpoints", every=30000)
+
+
+def test_table_gives_success_with_interval_and_counts():
+    scores = [CheckpointScore(PRETRAIN_STEP, 30, 12, (0.246, 0.577), "c0"),
+              CheckpointScore(50000, 30, 3, (0.035, 0.256), "c1")]
+    lines = markdown({"run_a": scores}, "unseen").splitlines()
+    assert lines[0] == "| run | env steps | unseen: success % [95% CI] | episodes |"
+    assert lines[2] == "| run_a | warm start | 40 [25, 58] | 12/30 |"
+    assert lines[3] == "| run_a | 50,000 | 10 [4, 26] | 3/30 |"

@@ -1,0 +1,23 @@
+"""Evaluation settings recorded beside a policy zip."""
+
+import yaml
+
+from homing_train.harness.policies import recorded_settings
+
+
+def test_a_run_folders_models_and_checkpoints_take_the_runs_training_settings(tmp_path):
+    run = tmp_path / "run"
+    (run / "checkpoints").mkdir(parents=True)
+    (run / "config.yml").write_text(yaml.safe_dump({
+        "env_id": "homing_gym/LocalHoming-v0",
+        "env_kwargs": {"scene": ["random_rooms"], "panorama_shape": [16, 128]}}))
+    for zip_path in (run / "best_model.zip", run / "checkpoints" / "ppo_50000_steps.zip"):
+        settings = recorded_settings(str(zip_path))
+        assert settings.env_id == "homing_gym/LocalHoming-v0"
+        # the training scene is dropped: the evaluation's own scene applies
+        assert settings.env_kwargs == {"panorama_shape": [16, 128]}
+        assert settings.params == {}
+    config = yaml.safe_load((run / "config.yml").read_text())
+    (run / "config.yml").write_text(yaml.safe_dump({**config, "eval_deterministic": False}))
+    assert recorded_settings(str(run / "best_model.zip")).params == {"deterministic": False}
+    assert recorded_settings(str(tmp_path / "elsewhere.zip")).env_kwargs == {}

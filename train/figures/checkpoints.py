@@ -1,0 +1,171 @@
+"""Success against training steps, on the training worlds and on worlds the policy never
+saw: every saved checkpoint of ``homing-train`` runs scored on a protocol.
+
+``python -m homing_train.figures.checkpoints runs/A runs/B --protocol unseen --episodes 5 --every 50000 4096 --out docs/generalisation``
+
+scores ``RUN/checkpoints/ppo_<steps>_steps.zip`` (every ``--every`` steps; one value per run, or one for all) and, where
+the run has one, ``RUN/pretrain_model.zip`` (the warm start, drawn before step 0) on
+``--protocol`` with ``--episodes`` per setting, each with the settings recorded in the run
+(:func:`homing_train.harness.policies.recorded_settings`), the harness's stop rule and
+deterministic actions unless the run evaluated stochastically. Each checkpoint's cell is
+kept in ``RUN/checkpoint_cells/<protocol>/<steps>/``, so an interrupted command resumes.
+Writes ``checkpoints_<protocol>.png`` (success % with Wilson 95 % intervals against env
+steps, one colour per run; dashed: the run's own evaluations on held-out *training*
+seeds from ``evaluations.npz``) and ``checkpoints_<protocol>.md`` (the table).
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from homing_gym.cli import command_parser
+from homing_train.harness.matrix import run_cell
+from homing_train.harness.protocols import PROTOCOLS, protocol
+
+_CHECKPOINT = re.compile(r"ppo_(\d+)_steps\.zip$")
+#: Plot position (env steps) of a run's warm start, drawn before its first PPO step.
+PRETRAIN_STEP = -1
+#: Line colours of the runs, in order (Okabe & Ito).
+RUN_COLOURS = ("#D55E00", "#009E73", "#0072B2", "#E69F00", "#CC79A7", "#56B4E9")
+
+
+@dataclass
+class CheckpointScore:
+    """One checkpoint's cell: env steps (``PRETRAIN_STEP`` for the warm start), episodes,
+    successes under the stop rule, the Wilson 95 % interval and the command."""
+
+    steps: int
+    episodes: int
+    successes: int
+    ci: tuple[float, float]
+    command: str
+
+
+def run_checkpoints(run: Path, every: int) -> list[tuple[int, Path]]:
+    """``(steps, zip)`` of the run's warm start (if any) and of its checkpoints whose
+    step count is a multiple of ``every``, in step order."""
+    found = sorted((int(m.group(1)), p) for p in (run / "checkpoints").glob("ppo_*_steps.zip")
+                   if (m := _CHECKPOINT.search(p.name)))
+    chosen = [(s, p) for s, p in found if s % every == 0]
+    if (run / "pretrain_model.zip").is_file():
+        chosen.insert(0, (PRETRAIN_STEP, run / "pretrain_model.zip"))
+    if not chosen:
+        raise ValueError(f"{run} has no checkpoints at multiples of {every} steps "
+                         f"(found {[s for s, _ in found]}) and no pretrain_model.zip")
+    return chosen
+
+
+def score_run(run: Path, protocol_name: str, episodes: int, every: int,
+              progress: bool = True) -> list[CheckpointScore]:
+    """Every chosen checkpoint of ``run`` scored on the protocol (resuming kept cells)."""
+    chosen_protocol = protocol(protocol_name)
+    scores = []
+    for steps, model in run_checkpoints(run, every):
+        out = run / "checkpoint_cells" / protocol_name / str(steps)
+        cell = run_cell(chosen_protocol, str(model), out, episodes=episodes,
+                        progress=progress, resume=True)
+        n = cell.summary["episodes"]
+        scores.append(CheckpointScore(steps, n, round(cell.summary["success_rate"] * n),
+                                      tuple(cell.summary["success_ci"]), cell.command))
+    return scores
+
+
+def training_evaluations(run: Path) -> tuple[np.ndarray, np.ndarray]:
+    """Steps and success rates of the run's evaluation callback (empty without one)."""
+    path = run / "evaluations.npz"
+    if not path.is_file():
+        return np.zeros(0), np.zeros(0)
+    data = np.load(path)
+    if "successes" not in data or data["successes"].size == 0:
+        return np.zeros(0), np.zeros(0)
+    return data["timesteps"], data["successes"].mean(axis=1)
+
+
+def markdown(results: dict[str, list[CheckpointScore]], protocol_name: str) -> str:
+    """One row per run and checkpoint: success % [Wilson 95 % CI] (k/n)."""
+    rows = [f"| run | env steps | {protocol_name}: success % [95% CI] | episodes |",
+            "|---|---:|---:|---:|"]
+    for run, scores in results.items():
+        for s in scores:
+            steps = "warm start" if s.steps == PRETRAIN_STEP else f"{s.steps:,}"
+            rows.append(f"| {run} | {steps} | {100 * s.successes / s.episodes:.0f} "
+                        f"[{100 * s.ci[0]:.0f}, {100 * s.ci[1]:.0f}] | "
+                        f"{s.successes}/{s.episodes} |")
+    return "\n".join(rows) + "\n"
+
+
+def plot(results: dict[str, list[CheckpointScore]], runs: dict[str, Path],
+         protocol_name: str, path: Path) -> None:
+    """Success against env steps per run (solid, with intervals) and the run's
+    training-seed evaluations (dashed)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7.5, 4.0), dpi=150)
+    for (name, scores), colour in zip(results.items(), RUN_COLOURS):
+        steps = np.array([max(s.steps, 0) for s in scores])
+        rate = np.array([100 * s.successes / s.episodes for s in scores])
+        low = rate - np.array([100 * s.ci[0] for s in scores])
+        high = np.array([100 * s.ci[1] for s in scores]) - rate
+        ax.errorbar(steps, rate, yerr=[low, high], color=colour, marker="o", ms=4,
+                    capsize=2, label=f"{name}: {protocol_name} "
+                                     f"({scores[0].episodes} episodes each)")
+        if scores[0].steps == PRETRAIN_STEP:
+            ax.annotate("warm start", (0, rate[0]), textcoords="offset points",
+                        xytext=(4, 6), fontsize=7, color=colour)
+        train_steps, train_rate = training_evaluations(runs[name])
+        if len(train_steps):
+            ax.plot(train_steps, 100 * train_rate, color=colour, ls="--", lw=1,
+                    label=f"{name}: training worlds (held-out seeds)")
+    ax.set_xlabel("environment steps of PPO")
+    ax.set_ylabel("success % (stopped within radius)")
+    ax.set_ylim(-2, 102)
+    ax.legend(fontsize=7, loc="upper left")
+    ax.set_title(f"success against training steps; {protocol_name}: Wilson 95% intervals",
+                 fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = command_parser("python -m homing_train.figures.checkpoints", __doc__)
+    parser.add_argument("runs", nargs="+", type=Path, help="homing-train run folders")
+    parser.add_argument("--protocol", default="unseen", choices=sorted(PROTOCOLS))
+    parser.add_argument("--episodes", type=int, default=5, help="episodes per setting")
+    parser.add_argument("--every", type=int, nargs="+", default=[50000],
+                        help="score the checkpoints at multiples of this many steps (one "
+                             "value for every run, or one per run)")
+    parser.add_argument("--out", type=Path, default=Path("docs/generalisation"))
+    parser.add_argument("--no-progress", action="store_true")
+    args = parser.parse_args(argv)
+    if len(args.every) == 1:
+        args.every *= len(args.runs)
+    if args.episodes < 1 or min(args.every) < 1 or len(args.every) != len(args.runs):
+        parser.error(f"--episodes and --every must be >= 1, and --every one value or one "
+                     f"per run; got {args.episodes}, {args.every} for {len(args.runs)} runs")
+    runs = {run.name: run for run in args.runs}
+    try:
+        results = {name: score_run(run, args.protocol, args.episodes, every,
+                                   not args.no_progress)
+                   for (name, run), every in zip(runs.items(), args.every)}
+    except ValueError as err:
+        parser.exit(2, f"checkpoints: error: {err}\n")
+    args.out.mkdir(parents=True, exist_ok=True)
+    table = markdown(results, args.protocol)
+    (args.out / f"checkpoints_{args.protocol}.md").write_text(table)
+    plot(results, runs, args.protocol, args.out / f"checkpoints_{args.protocol}.png")
+    print(table)
+    print(f"wrote {args.out}/checkpoints_{args.protocol}.md and .png")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
