@@ -9,8 +9,8 @@ the run has one, ``RUN/pretrain_model.zip`` (the warm start, drawn before step 0
 (:func:`homing_train.harness.policies.recorded_settings`), the harness's stop rule and
 deterministic actions unless the run evaluated stochastically. Each checkpoint's cell is
 kept in ``RUN/checkpoint_cells/<protocol>/<steps>/``, so an interrupted command resumes.
-Writes ``checkpoints_<protocol>.png`` (success % with Wilson 95 % intervals against env
-steps, one colour per run; dashed: the run's own evaluations on held-out *training*
+Writes ``checkpoints_<protocol>.png`` (one panel per run: success % with Wilson 95 %
+intervals against env steps; dashed: the run's own evaluations on held-out *training*
 seeds from ``evaluations.npz``) and ``checkpoints_<protocol>.md`` (the table).
 """
 
@@ -101,34 +101,35 @@ def markdown(results: dict[str, list[CheckpointScore]], protocol_name: str) -> s
 
 def plot(results: dict[str, list[CheckpointScore]], runs: dict[str, Path],
          protocol_name: str, path: Path) -> None:
-    """Success against env steps per run (solid, with intervals) and the run's
-    training-seed evaluations (dashed)."""
+    """One panel per run: success against env steps on the protocol (solid, with
+    intervals) and on the run's held-out training seeds (dashed)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7.5, 4.0), dpi=150)
-    for (name, scores), colour in zip(results.items(), RUN_COLOURS):
+    fig, axes = plt.subplots(1, len(results), figsize=(4.2 * len(results), 3.6), dpi=150,
+                             sharey=True, squeeze=False)
+    for ax, (name, scores), colour in zip(axes[0], results.items(), RUN_COLOURS):
         steps = np.array([max(s.steps, 0) for s in scores])
         rate = np.array([100 * s.successes / s.episodes for s in scores])
         low = rate - np.array([100 * s.ci[0] for s in scores])
         high = np.array([100 * s.ci[1] for s in scores]) - rate
         ax.errorbar(steps, rate, yerr=[low, high], color=colour, marker="o", ms=4,
-                    capsize=2, label=f"{name}: {protocol_name} "
-                                     f"({scores[0].episodes} episodes each)")
+                    capsize=2, label=f"{protocol_name} ({scores[0].episodes} episodes each)")
         if scores[0].steps == PRETRAIN_STEP:
             ax.annotate("warm start", (0, rate[0]), textcoords="offset points",
-                        xytext=(4, 6), fontsize=7, color=colour)
+                        xytext=(4, -12), fontsize=7, color=colour)
         train_steps, train_rate = training_evaluations(runs[name])
         if len(train_steps):
             ax.plot(train_steps, 100 * train_rate, color=colour, ls="--", lw=1,
-                    label=f"{name}: training worlds (held-out seeds)")
-    ax.set_xlabel("environment steps of PPO")
-    ax.set_ylabel("success % (stopped within radius)")
-    ax.set_ylim(-2, 102)
-    ax.legend(fontsize=7, loc="upper left")
-    ax.set_title(f"success against training steps; {protocol_name}: Wilson 95% intervals",
+                    label="training worlds, held-out seeds")
+        ax.set_title(name, fontsize=9)
+        ax.set_xlabel("environment steps of PPO")
+        ax.set_ylim(-2, 102)
+        ax.legend(fontsize=7, loc="upper right")
+    axes[0][0].set_ylabel("success % (stopped within radius)")
+    fig.suptitle(f"success against training steps (Wilson 95% intervals on {protocol_name})",
                  fontsize=9)
     fig.tight_layout()
     fig.savefig(path)
