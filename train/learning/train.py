@@ -356,6 +356,11 @@ def _restore_evaluations(callback, run: Path) -> None:
         callback.best_mean_reward = float(np.max(np.mean(data["results"], axis=1)))
 
 
+def _raise_interrupt(signum, frame) -> None:
+    """A signal handler that stops training as Ctrl-C does."""
+    raise KeyboardInterrupt(f"signal {signum}")
+
+
 def set_actor_trainable(policy, trainable: bool) -> None:
     """Freeze (``trainable=False``) or release every parameter of an SB3 actor-critic
     policy except the critic's own layers (value MLP and head, and its features extractor
@@ -511,6 +516,9 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
         warmup = min(max(config.critic_warmup_steps - start_steps, 0), max(remaining, 0))
         fresh = checkpoint is None
         interrupted = False
+        # SIGTERM (a scheduler's stop, `kill`) ends the run as Ctrl-C does: what was learned
+        # is saved; background jobs ignore SIGINT, so this is how they are stopped cleanly
+        previous_term = signal.signal(signal.SIGTERM, _raise_interrupt)
         try:
             for steps, critic_only in ((warmup, True), (remaining - warmup, False)):
                 if steps <= 0:
@@ -526,6 +534,8 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
             if error is None:
                 raise
             raise error from err
+        finally:
+            signal.signal(signal.SIGTERM, previous_term)
         set_actor_trainable(model.policy, True)
         wall = time.perf_counter() - t0
         model.save(out / "model.zip")

@@ -311,6 +311,28 @@ def test_suite_runs_the_controllers_made_for_the_env():
     assert "bearing-longrange" in suite_methods("homing_gym/LongRangeHoming-v0")
 
 
+def test_sigterm_saves_the_run_as_ctrl_c_does(tmp_path, monkeypatch):
+    import os
+    import signal
+
+    from stable_baselines3 import PPO
+
+    real_learn = PPO.learn
+
+    def learn_then_terminate(self, *args, **kwargs):
+        real_learn(self, *args, **kwargs)
+        os.kill(os.getpid(), signal.SIGTERM)      # `kill PID` of a background run
+
+    before = signal.getsignal(signal.SIGTERM)
+    run = tmp_path / "run"
+    monkeypatch.setattr(PPO, "learn", learn_then_terminate)
+    assert main(["--timesteps", "128", "--out", str(run), *TINY]) == 130
+    summary = json.loads((run / "summary.json").read_text())
+    assert summary["interrupted"] and (run / "model.zip").is_file()
+    assert latest_checkpoint(run).name == "ppo_128_steps.zip"
+    assert signal.getsignal(signal.SIGTERM) is before
+
+
 def test_ctrl_c_saves_the_run_and_resume_continues_with_new_episode_seeds(tmp_path,
                                                                           monkeypatch):
     from stable_baselines3 import PPO
