@@ -63,6 +63,17 @@ class CircularConv1d(nn.Module):
         return F.relu(self.conv(F.pad(x, (self.pad, self.pad), mode="circular")))
 
 
+def conv_layers(conv: type[nn.Module], c_in: int,
+                layers: tuple[tuple[int, int, int], ...]) -> list[nn.Module]:
+    """``conv(c_in, c_out, kernel, stride)`` for each (channels, kernel, stride) of
+    ``layers``, each taking the previous one's channels."""
+    modules = []
+    for c_out, kernel, stride in layers:
+        modules.append(conv(c_in, c_out, kernel, stride))
+        c_in = c_out
+    return modules
+
+
 class PanoramaGoalExtractor(BaseFeaturesExtractor):
     """Early-fusion CNN over ``image_keys`` (default: panorama and goal) stacked as channels;
     other keys are flattened and appended. ``layers``: (channels, kernel, stride) of each
@@ -99,11 +110,7 @@ class PanoramaGoalExtractor(BaseFeaturesExtractor):
 
     def trunk(self, c_in: int, layers: tuple[tuple[int, int, int], ...]) -> nn.Sequential:
         """The convolutions (:attr:`conv`, circular along azimuth), then a flatten."""
-        convs = []
-        for c_out, kernel, stride in layers:
-            convs.append(self.conv(c_in, c_out, kernel, stride))
-            c_in = c_out
-        return nn.Sequential(*convs, nn.Flatten())
+        return nn.Sequential(*conv_layers(self.conv, c_in, layers), nn.Flatten())
 
     def forward(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
         features = [self.linear(self.cnn(self.fused(observations)))]
@@ -171,21 +178,14 @@ class AlignedBandExtractor(BaseFeaturesExtractor):
         channels, rows, width = observation_space[image_keys[0]].shape
         self.image_keys = tuple(image_keys)
         self.extra_keys = tuple(extra_keys)
-        self.encoder = self._convs(channels * rows, encoder)
-        self.head = nn.Sequential(self._convs(3 * encoder[-1][0], head), nn.Flatten())
+        self.encoder = nn.Sequential(*conv_layers(CircularConv1d, channels * rows, encoder))
+        self.head = nn.Sequential(nn.Sequential(*conv_layers(CircularConv1d, 3 * encoder[-1][0],
+                                                             head)), nn.Flatten())
         with torch.no_grad():
             n_flat = self.head(torch.zeros(1, 3 * encoder[-1][0], width)).shape[1]
         self.log_temperature = nn.Parameter(torch.tensor(float(temperature)).log())
         self.linear = nn.Sequential(nn.Linear(n_flat + width, features_dim),
                                     nn.LayerNorm(features_dim))
-
-    @staticmethod
-    def _convs(c_in: int, layers: tuple[tuple[int, int, int], ...]) -> nn.Sequential:
-        convs = []
-        for c_out, kernel, stride in layers:
-            convs.append(CircularConv1d(c_in, c_out, kernel, stride))
-            c_in = c_out
-        return nn.Sequential(*convs)
 
     def column_features(self, image: torch.Tensor) -> torch.Tensor:
         """Unit-length per-column features ``(N, K, W)`` of standardised ``(N, C, H, W)``
