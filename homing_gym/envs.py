@@ -150,18 +150,20 @@ class LocalHomingEnv(HomingEnv):
                                success_on=success_on, reward=reward)
         super().__init__(task, scene, **kwargs)
 
-    def set_start_distance(self, start_distance: tuple[float, float]) -> None:
+    def set_start_distance(self, start_distance: tuple[float, float],
+                           success_radius: float | None = None) -> None:
         """Draw the starts of the following resets ``start_distance`` = (min, max) metres
-        from home (the episode under way keeps its start): the hook of a training
+        from home (the episode under way keeps its start) and, when given, judge arrival
+        with ``success_radius`` metres from the next step on: the hook of a training
         curriculum, e.g. ``vec_env.env_method("set_start_distance", (0.2, 0.6))``. Checked
-        as the argument ``start_distance`` is (also against the current scene); a bad
-        value raises ``ValueError`` and changes nothing."""
-        previous = self.task.start_distance
-        self.task.set_start_distance(start_distance)
+        as the arguments ``start_distance`` and ``success_radius`` are (also against the
+        current scene); a bad value raises ``ValueError`` and changes nothing."""
+        previous = self.task.start_distance, self.task.success_radius
+        self.task.set_start_distance(start_distance, success_radius)
         try:
             self.task.check_scene(self.scene)
         except ValueError:
-            self.task.start_distance = previous
+            self.task.start_distance, self.task.success_radius = previous
             raise
 
 

@@ -9,6 +9,7 @@ import numpy as np
 from homing_gym.scenes.base import Scene, clearance
 from homing_gym.tasks.base import Episode, sample_free_pose
 from homing_gym.tasks.goal_reaching import GoalReachingTask, RewardConfig
+from homing_gym.validation import require_positive
 
 
 class LocalHomingTask(GoalReachingTask):
@@ -23,20 +24,24 @@ class LocalHomingTask(GoalReachingTask):
         self.set_start_distance(start_distance)
         self.clearance_margin = clearance_margin
 
-    def set_start_distance(self, start_distance: tuple[float, float]) -> None:
+    def set_start_distance(self, start_distance: tuple[float, float],
+                           success_radius: float | None = None) -> None:
         """Draw the following episodes' starts ``start_distance`` = (min, max) metres from
-        home, min at least ``success_radius``; a bad value raises ``ValueError`` and
-        leaves the range as it was."""
+        home, min at least the success radius; ``success_radius`` (metres, optional)
+        replaces that radius at the same time (a curriculum that narrows it). A bad value
+        raises ``ValueError`` and leaves both as they were."""
+        radius = self.success_radius if success_radius is None else success_radius
+        require_positive("success_radius", radius, "metres")
         lo, hi = (start_distance if np.ndim(start_distance) == 1 and len(start_distance) == 2
                   else (math.nan, math.nan))
         if not (math.isfinite(lo) and math.isfinite(hi) and 0 <= lo <= hi):
             raise ValueError(f"start_distance must be (min, max) metres with 0 <= min <= max, "
                              f"got {start_distance!r}")
-        if lo < self.success_radius:
+        if lo < radius:
             raise ValueError(f"start_distance {start_distance!r} m must start at or beyond "
-                             f"success_radius {self.success_radius!r} m: an episode must not "
-                             f"begin at home")
+                             f"success_radius {radius!r} m: an episode must not begin at home")
         self.start_distance = (float(lo), float(hi))
+        self.success_radius = float(radius)
 
     def check_scene(self, scene: Scene) -> None:
         width, depth = scene.size

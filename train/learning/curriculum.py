@@ -1,15 +1,21 @@
-"""A curriculum on the start distance of the training envs (``curriculum`` setting of
-``homing-train``).
+"""A curriculum on the start distance (and optionally the success radius) of the training
+envs (``curriculum`` setting of ``homing-train``).
 
     curriculum: {start_distance: [[0.15, 0.35], [0.2, 0.6], [0.3, 1.0], [0.3, 1.5]],
                  promote_at: 0.5, window: 200}
+    curriculum: {start_distance: [[0.3, 1.5], [0.3, 1.5], [0.3, 1.5]],
+                 success_radius: [0.3, 0.2, 0.15], promote_at: 0.5, window: 200}
 
-The training envs start at stage 0's ``(min, max)`` metres from home. When at least
+The training envs start at stage 0's ``(min, max)`` metres from home and, with
+``success_radius`` (one radius per stage, metres), count a stop within that stage's radius
+as a success. When at least
 ``promote_at`` of the last ``window`` training episodes finished at the current stage were
 successes (``is_success`` of the episode's last step, as SB3's ``Monitor`` records it), every
-training env moves to the next stage (``env_method("set_start_distance", ...)``, e.g.
+training env moves to the next stage (``env_method("set_start_distance", ...)``, with the
+stage's radius as ``success_radius=`` when there is one, e.g.
 :meth:`homing_gym.envs.LocalHomingEnv.set_start_distance`) and the window starts empty.
-The evaluation envs are not touched: they keep ``env_kwargs``' ``start_distance``.
+The evaluation envs are not touched: they keep ``env_kwargs``' ``start_distance`` and
+``success_radius``.
 The callback that does it is :class:`~homing_train.learning.curriculum_callback.CurriculumCallback`
 (apart, so that this module imports without stable-baselines3, as ``train.py`` does).
 """
@@ -37,11 +43,26 @@ def _number(value: Any) -> bool:
 class CurriculumSettings:
     """``start_distance``: the stages, each ``(min, max)`` metres from home, in order;
     ``promote_at``: success rate in (0, 1] that moves the envs to the next stage;
-    ``window``: finished episodes (at least 1) over which that rate is taken."""
+    ``window``: finished episodes (at least 1) over which that rate is taken;
+    ``success_radius``: one success radius per stage (metres), or ``None`` to keep the
+    env's own."""
 
     start_distance: tuple[tuple[float, float], ...]
     promote_at: float = 0.5
     window: int = 200
+    success_radius: tuple[float, ...] | None = None
+
+    def stage_kwargs(self, stage: int) -> dict[str, Any]:
+        """The keyword arguments of the env hook for ``stage`` beyond its start distance."""
+        return {} if self.success_radius is None else {"success_radius": self.success_radius[stage]}
+
+    def as_dict(self) -> dict[str, Any]:
+        """The settings as ``from_value`` reads them (JSON-ready)."""
+        out = {"start_distance": [list(s) for s in self.start_distance],
+               "promote_at": self.promote_at, "window": self.window}
+        if self.success_radius is not None:
+            out["success_radius"] = list(self.success_radius)
+        return out
 
     @classmethod
     def from_value(cls, value: Mapping[str, Any]) -> "CurriculumSettings":
@@ -49,8 +70,8 @@ class CurriculumSettings:
         ``ValueError`` naming the bad value and what is allowed."""
         if not isinstance(value, Mapping):
             raise ValueError(f"curriculum must be a mapping with keys start_distance, "
-                             f"promote_at, window, got {value!r}")
-        allowed = ("start_distance", "promote_at", "window")
+                             f"promote_at, window, success_radius, got {value!r}")
+        allowed = ("start_distance", "promote_at", "window", "success_radius")
         unknown = sorted(set(value) - set(allowed))
         if unknown:
             raise ValueError(f"unknown curriculum settings {unknown}; allowed: {list(allowed)}")
@@ -68,8 +89,15 @@ class CurriculumSettings:
         if not (isinstance(window, int) and not isinstance(window, bool) and window >= 1):
             raise ValueError(f"curriculum window must be an integer >= 1 (episodes), got "
                              f"{window!r}")
+        radii = value.get("success_radius")
+        if radii is not None and not (
+                isinstance(radii, (list, tuple)) and len(radii) == len(stages)
+                and all(_number(r) and r > 0 for r in radii)):
+            raise ValueError(f"curriculum success_radius must be a list of {len(stages)} "
+                             f"positive radii in metres, one per start_distance stage, got "
+                             f"{radii!r}")
         return cls(tuple((float(lo), float(hi)) for lo, hi in stages), float(promote_at),
-                   window)
+                   window, None if radii is None else tuple(float(r) for r in radii))
 
 
 def last_stage(path: Path) -> tuple[int, list[dict]]:
@@ -85,10 +113,17 @@ def mark_stages(ax, stages: list[dict]) -> None:
     """Dashed lines on ``ax`` (x: env steps) where each stage after the first began."""
     for stage in stages[1:]:
         ax.axvline(stage["from_step"], color="tab:gray", ls="--", lw=1)
-        lo, hi = stage["start_distance"]
-        ax.annotate(f"stage {stage['stage']}: {lo:g}-{hi:g} m", (stage["from_step"], 1),
+        ax.annotate(f"stage {stage['stage']}: {stage_label(stage)}", (stage["from_step"], 1),
                     xycoords=("data", "axes fraction"), color="tab:gray", rotation=90,
                     va="top", ha="right", fontsize=8)
+
+
+def stage_label(stage: dict) -> str:
+    """``"0.3-1.5 m"``, with ``", radius 0.2 m"`` when the stage sets one (a
+    ``curriculum.json`` stage record)."""
+    lo, hi = stage["start_distance"]
+    radius = stage.get("success_radius")
+    return f"{lo:g}-{hi:g} m" + ("" if radius is None else f", radius {radius:g} m")
 
 
 def plot_training_success(ax, tb: Path, stages: list[dict]) -> None:
@@ -109,5 +144,4 @@ def plot_training_success(ax, tb: Path, stages: list[dict]) -> None:
     ax.set_xlabel("environment steps")
     ax.set_ylabel("training success rate (%)")
     ax.set_ylim(0, 100)
-    lo, hi = stages[0]["start_distance"]
-    ax.set_title(f"training episodes (stage 0: {lo:g}-{hi:g} m)")
+    ax.set_title(f"training episodes (stage 0: {stage_label(stages[0])})")

@@ -1,4 +1,4 @@
-"""The SB3 callback of the start-distance curriculum (:mod:`homing_train.learning.curriculum`:
+"""The SB3 callback of the start-distance (and success-radius) curriculum (:mod:`homing_train.learning.curriculum`:
 the setting, the stages, the plots)."""
 
 from __future__ import annotations
@@ -17,7 +17,8 @@ class CurriculumCallback(BaseCallback):
     """Moves the training envs through the stages of ``settings`` (see the module).
 
     Logs ``curriculum/stage``, ``curriculum/success_rate`` (over the current window) and
-    ``curriculum/max_start_distance`` (m) with every rollout, and writes the stages
+    ``curriculum/max_start_distance`` (m) (and ``curriculum/success_radius``, m, when the
+    stages set one) with every rollout, and writes the stages
     reached, with the env step of each, to ``path`` (JSON). ``stage``: the stage to start
     from (a resumed run's last one, :func:`last_stage`)."""
 
@@ -41,15 +42,14 @@ class CurriculumCallback(BaseCallback):
     def _enter(self, stage: int) -> None:
         self.stage = stage
         self.outcomes.clear()
-        self.training_env.env_method(HOOK, self.settings.start_distance[stage])
+        extra = self.settings.stage_kwargs(stage)
+        self.training_env.env_method(HOOK, self.settings.start_distance[stage], **extra)
         if not self.history or self.history[-1]["stage"] != stage:
             self.history.append({"stage": stage,
                                  "start_distance": list(self.settings.start_distance[stage]),
-                                 "from_step": int(self.num_timesteps)})
-        self.path.write_text(json.dumps({"settings": {
-            "start_distance": [list(s) for s in self.settings.start_distance],
-            "promote_at": self.settings.promote_at, "window": self.settings.window},
-            "stages": self.history}, indent=2))
+                                 **extra, "from_step": int(self.num_timesteps)})
+        self.path.write_text(json.dumps({"settings": self.settings.as_dict(),
+                                         "stages": self.history}, indent=2))
 
     def _on_training_start(self) -> None:
         self._enter(self.stage)
@@ -69,3 +69,5 @@ class CurriculumCallback(BaseCallback):
         self.logger.record("curriculum/success_rate", self.success_rate)
         self.logger.record("curriculum/max_start_distance",
                            self.settings.start_distance[self.stage][1])
+        for name, value in self.settings.stage_kwargs(self.stage).items():
+            self.logger.record(f"curriculum/{name}", value)

@@ -417,7 +417,7 @@ def check_curriculum(env: gym.Env, curriculum: CurriculumSettings) -> None:
                          f"start distance (LocalHoming-v0 has one)")
     for i, stage in enumerate(curriculum.start_distance):
         try:
-            hook(stage)
+            hook(stage, **curriculum.stage_kwargs(i))
         except ValueError as err:
             raise ValueError(f"curriculum stage {i}: {err}") from err
 

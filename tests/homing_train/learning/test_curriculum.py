@@ -1,4 +1,4 @@
-"""The start-distance curriculum of homing-train: promotion on the success rate of the
+"""The start-distance (and success-radius) curriculum of homing-train: promotion on the success rate of the
 last finished episodes, the env hook it drives, and its settings' checks."""
 
 import json
@@ -25,10 +25,13 @@ class OneStepEnv(gym.Env):
     def __init__(self, period: int = 1, easy: float = 0.5):
         self.period, self.easy = period, easy
         self.start_distance = (0.3, 1.5)
+        self.success_radius = 0.15
         self.episodes = 0
 
-    def set_start_distance(self, start_distance):
+    def set_start_distance(self, start_distance, success_radius=None):
         self.start_distance = tuple(start_distance)
+        if success_radius is not None:
+            self.success_radius = success_radius
 
     def reset(self, *, seed=None, options=None):
         super().reset(seed=seed)
@@ -47,16 +50,18 @@ class NoHookEnv(OneStepEnv):
 gym.register("curriculum_test/OneStep-v0", entry_point=OneStepEnv)
 
 
-def _learn(tmp_path, period, promote_at, window=8, steps=256):
+def _learn(tmp_path, period, promote_at, window=8, steps=256, **settings):
     """PPO on two monitored :class:`OneStepEnv` (wrapped as homing-train wraps its envs)
-    with the curriculum callback; returns the callback and the vector env."""
+    with the curriculum callback (more ``settings`` of it as keywords); returns the
+    callback and the vector env."""
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import DummyVecEnv
 
     env = DummyVecEnv([lambda: make_monitored_env("curriculum_test/OneStep-v0",
                                                   {"period": period})] * 2)
     settings = CurriculumSettings.from_value({"start_distance": STAGES,
-                                              "promote_at": promote_at, "window": window})
+                                              "promote_at": promote_at, "window": window,
+                                              **settings})
     callback = CurriculumCallback(settings, tmp_path / "curriculum.json")
     PPO("MlpPolicy", env, n_steps=32, batch_size=32, n_epochs=1, seed=0).learn(
         steps, callback=callback)
@@ -82,6 +87,33 @@ def test_the_stage_advances_when_the_window_success_rate_reaches_promote_at(
         assert 8 <= record["stages"][1]["from_step"] <= 8 + 2 * period
         assert callback.success_rate == 0.0     # the window restarted at stage 1
     assert last_stage(tmp_path / "curriculum.json") == (stage, record["stages"])
+
+
+def test_a_stage_sets_its_success_radius_on_the_envs_and_in_the_record(tmp_path):
+    callback, env = _learn(tmp_path, 1, 0.5, success_radius=[0.3, 0.2, 0.15])
+    assert callback.stage == 1
+    assert env.get_attr("success_radius") == [0.2, 0.2]
+    record = json.loads((tmp_path / "curriculum.json").read_text())
+    assert record["settings"]["success_radius"] == [0.3, 0.2, 0.15]
+    assert [(s["stage"], s["success_radius"]) for s in record["stages"]] == [(0, 0.3), (1, 0.2)]
+
+
+def test_set_start_distance_can_change_the_success_radius_with_it():
+    env = gym.make("homing_gym/LocalHoming-v0", panorama_shape=(16, 64))
+    task = env.unwrapped.task
+    env.unwrapped.set_start_distance((0.4, 0.6), success_radius=0.4)
+    assert (task.start_distance, task.success_radius) == ((0.4, 0.6), 0.4)
+    _, info = env.reset(seed=3)
+    assert 0.4 <= math.dist(info["start_pose"][:2], info["home_pose"][:2]) <= 0.6
+    # both are checked together; a refusal changes neither
+    for bad, radius, message in (((0.3, 0.6), 0.35, "must start at or beyond success_radius 0.35"),
+                                 ((0.4, 0.6), 0.0, "success_radius"),
+                                 ((0.4, 0.6), math.nan, "success_radius"),
+                                 ((0.5, 9.0), 0.3, "does not fit")):
+        with pytest.raises(ValueError, match=message):
+            env.unwrapped.set_start_distance(bad, success_radius=radius)
+        assert (task.start_distance, task.success_radius) == ((0.4, 0.6), 0.4)
+    env.close()
 
 
 def test_set_start_distance_changes_the_sampled_start_distances():
@@ -121,6 +153,10 @@ def test_set_start_distance_changes_the_sampled_start_distances():
     ({"start_distance": STAGES, "window": 0}, r"window must be an integer >= 1 .*got 0"),
     ({"start_distance": STAGES, "window": 2.5}, "window"),
     ({"start_distance": STAGES, "window": True}, "window"),
+    ({"start_distance": STAGES, "success_radius": [0.2, 0.15]},
+     r"success_radius must be a list of 3 positive radii"),
+    ({"start_distance": STAGES, "success_radius": [0.2, 0.15, 0]}, "success_radius"),
+    ({"start_distance": STAGES, "success_radius": 0.15}, "success_radius"),
 ])
 def test_bad_curriculum_settings_raise_value_error(curriculum, message):
     with pytest.raises(ValueError, match=message):
@@ -133,6 +169,10 @@ def test_stages_the_env_refuses_and_envs_without_the_hook_are_errors(tmp_path, c
     with pytest.raises(ValueError, match=r"curriculum stage 1: .*success_radius"):
         check_curriculum(env.unwrapped, CurriculumSettings.from_value(
             {"start_distance": [[0.2, 0.5], [0.1, 0.5]]}))
+    # stage 0 starts inside its own success radius (0.4 m)
+    with pytest.raises(ValueError, match=r"curriculum stage 0: .*success_radius 0.4"):
+        check_curriculum(env.unwrapped, CurriculumSettings.from_value(
+            {"start_distance": [[0.3, 1.5]], "success_radius": [0.4]}))
     env.close()
     with pytest.raises(ValueError, match="has no set_start_distance"):
         check_curriculum(NoHookEnv(), CurriculumSettings.from_value({"start_distance": STAGES}))
