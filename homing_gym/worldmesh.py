@@ -134,18 +134,37 @@ class _Builder:
 
     def cylinder(self, centre, radius: float, height: float, yaw: float, color,
                  tex: int) -> None:
+        """A closed prism of :data:`CYLINDER_SIDES` sides: per side, its quad's two
+        triangles, then the bottom and top triangles fanning from the axis."""
         a = yaw + np.linspace(0, 2 * math.pi, CYLINDER_SIDES + 1)
         x, y = centre[0] + radius * np.cos(a), centre[1] + radius * np.sin(a)
         z0, z1 = centre[2] - height / 2, centre[2] + height / 2
         u = np.linspace(0, 1, CYLINDER_SIDES + 1)
-        for k in range(CYLINDER_SIDES):
-            self.quad([(x[k], y[k], z0), (x[k + 1], y[k + 1], z0), (x[k + 1], y[k + 1], z1),
-                       (x[k], y[k], z1)], [(u[k], 0), (u[k + 1], 0), (u[k + 1], 1), (u[k], 1)],
-                      color, tex, inside=centre)
-            for z in (z0, z1):
-                self.triangle([(centre[0], centre[1], z), (x[k], y[k], z),
-                               (x[k + 1], y[k + 1], z)], np.full((3, 2), 0.001), color, tex,
-                              inside=centre)
+        n = CYLINDER_SIDES
+        now, nxt = np.arange(n), np.arange(1, n + 1)
+
+        def rim(z: float, k: np.ndarray) -> np.ndarray:
+            return np.column_stack([x[k], y[k], np.full(n, z)])
+
+        def axis(z: float) -> np.ndarray:
+            return np.broadcast_to([centre[0], centre[1], z], (n, 3))
+
+        quad = np.stack([rim(z0, now), rim(z0, nxt), rim(z1, nxt), rim(z1, now)], 1)
+        quad_uv = np.stack([np.column_stack([u[now], np.zeros(n)]),
+                            np.column_stack([u[nxt], np.zeros(n)]),
+                            np.column_stack([u[nxt], np.ones(n)]),
+                            np.column_stack([u[now], np.ones(n)])], 1)
+        caps = [np.stack([axis(z), rim(z, now), rim(z, nxt)], 1) for z in (z0, z1)]
+        tris = np.stack([quad[:, [0, 1, 2]], quad[:, [0, 2, 3]], *caps], 1).reshape(-1, 3, 3)
+        cap_uv = np.full((n, 3, 2), 0.001)
+        uvs = np.stack([quad_uv[:, [0, 1, 2]], quad_uv[:, [0, 2, 3]], cap_uv, cap_uv],
+                       1).reshape(-1, 3, 2)
+        self.tris.extend(tris)
+        self.uvs.extend(uvs)
+        self.inside.extend(np.broadcast_to(np.asarray(centre, np.float64), (len(tris), 3)))
+        self.colors.extend(np.broadcast_to(np.asarray(color[:3], np.float64), (len(tris), 3)))
+        self.tex.extend([tex] * len(tris))
+        self.closed.extend([True] * len(tris))
 
     def part(self, part: MeshPart) -> None:
         """A mesh part's faces (those of its closed solids marked ``closed``); a textured

@@ -60,9 +60,10 @@ def scene_factory(scene: "str | Scene | SceneFactory") -> SceneFactory:
         return SceneFactory(build=lambda rng, s=scene: s, description=scene.name)
     if isinstance(scene, str) and scene.startswith(MESH_PREFIX):
         return scene_factory(mesh_scene_from_spec(scene))
-    if scene not in _SCENES:
-        raise ValueError(f"unknown scene {scene!r}; allowed: {available_scenes()}, or "
-                         f"'{MESH_PREFIX}PATH' for a mesh file")
+    if not isinstance(scene, str) or scene not in _SCENES:
+        raise ValueError(f"unknown scene {scene!r}; allowed: {available_scenes()}, "
+                         f"'{MESH_PREFIX}PATH' for a mesh file, a Scene or a SceneFactory "
+                         f"(a list of names is for homing-train: env k of its vector env builds name k mod n)")
     return _SCENES[scene]
 
 

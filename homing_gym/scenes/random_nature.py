@@ -69,12 +69,23 @@ def _lump(rng: np.random.Generator, centre, size) -> tuple[np.ndarray, np.ndarra
     return vertices + [centre[0], centre[1], 0.0], faces
 
 
+@lru_cache(maxsize=1)
+def _unit_trunk() -> tuple[np.ndarray, np.ndarray]:
+    """Vertices and faces of trimesh's 10-sided cylinder of radius 1 and height 1 about
+    the origin (made once; scaled, it gives the very vertices trimesh makes for another
+    radius and height)."""
+    trunk = trimesh.creation.cylinder(radius=1.0, height=1.0, sections=10)
+    vertices, faces = np.array(trunk.vertices), np.array(trunk.faces)
+    vertices.flags.writeable = faces.flags.writeable = False
+    return vertices, faces
+
+
 def _tree(rng: np.random.Generator, xy) -> tuple[list, list]:
     """A trunk and a crown (each ``(vertices, faces)``) at floor point ``xy``, and their
     colours."""
     radius, height = float(rng.uniform(0.04, 0.15)), float(rng.uniform(1.5, 4.0))
-    trunk = trimesh.creation.cylinder(radius=radius, height=height, sections=10)
-    trunk.apply_translation((xy[0], xy[1], height / 2))
+    unit, trunk_faces = _unit_trunk()
+    trunk = unit * [radius, radius, height] + [xy[0], xy[1], height / 2]
     crown_r = float(rng.uniform(0.4, 1.2))
     ball, faces = _unit_ball()
     crown = ball * [crown_r, crown_r, crown_r * rng.uniform(0.8, 1.6)]
@@ -83,7 +94,7 @@ def _tree(rng: np.random.Generator, xy) -> tuple[list, list]:
     crown = crown + (xy[0], xy[1], low - crown[:, 2].min())
     bark = np.array([0.35, 0.25, 0.15]) * rng.uniform(0.6, 1.3)
     leaves = np.array([rng.uniform(0.1, 0.35), rng.uniform(0.35, 0.65), rng.uniform(0.05, 0.25)])
-    return [(trunk.vertices, trunk.faces), (crown, faces)], [bark, leaves]
+    return [(trunk, trunk_faces), (crown, faces)], [bark, leaves]
 
 
 def _ground(rng: np.random.Generator) -> MeshPart:

@@ -56,13 +56,29 @@ def _wall_with_door(a: tuple[float, float], b: tuple[float, float], rng, style: 
     return [Wall(a, at(centre - width / 2), **style), Wall(at(centre + width / 2), b, **style)]
 
 
-def _connected(scene: Scene) -> bool:
-    """Whether the robot's free floor is one connected area."""
-    (xmin, ymin), (xmax, ymax) = scene.bounds
-    gx, gy = np.meshgrid(np.arange(xmin, xmax, CHECK_GRID), np.arange(ymin, ymax, CHECK_GRID),
-                         indexing="ij")
-    free = (clearances(scene, np.stack([gx.ravel(), gy.ravel()], 1)) >= ROBOT_DISC)
-    return ndimage.label(free.reshape(gx.shape))[1] == 1
+class _FreeFloor:
+    """The clearance of every :data:`CHECK_GRID` point of ``scene``'s floor, kept up to
+    date as landmarks are added: a new landmark's clearance alone (with the bounds) is
+    folded in by a minimum, which gives the same values as :func:`clearances` of the
+    whole scene (a minimum over the parts) at the cost of one landmark."""
+
+    def __init__(self, scene: Scene):
+        (xmin, ymin), (xmax, ymax) = scene.bounds
+        gx, gy = np.meshgrid(np.arange(xmin, xmax, CHECK_GRID),
+                             np.arange(ymin, ymax, CHECK_GRID), indexing="ij")
+        self.shape, self.bounds = gx.shape, scene.bounds
+        self.points = np.stack([gx.ravel(), gy.ravel()], 1)
+        self.free = clearances(scene, self.points)
+
+    def with_landmark(self, landmark: Landmark) -> np.ndarray:
+        """The grid's clearances (metres) once ``landmark`` stands on the floor too."""
+        alone = Scene(name="landmark", bounds=self.bounds, walls=(), landmarks=(landmark,))
+        return np.minimum(self.free, clearances(alone, self.points))
+
+    def connected(self, free: np.ndarray) -> bool:
+        """Whether the points of the clearances ``free`` where the robot's disc fits make
+        one connected area."""
+        return ndimage.label((free >= ROBOT_DISC).reshape(self.shape))[1] == 1
 
 
 def _picture(wall: Wall, rng: np.random.Generator, side: float) -> Landmark | None:
@@ -154,13 +170,15 @@ def random_rooms_scene(rng: np.random.Generator) -> Scene:
                      walls=tuple(walls), landmarks=tuple(items), floor_color=floor["color"],
                      floor_texture=floor["texture"], metadata={"rooms": rooms})
 
-    scene = scene_with(landmarks)
+    items = list(landmarks)
+    floor_grid = _FreeFloor(scene_with(items))
     for room in rooms:
         for _ in range(int(rng.integers(1, 5))):
             item = _furniture(room, rng) if rng.random() < 0.75 else _plant(room, rng)
             if doors and min(math.dist(item.position, d) for d in doors) < 0.8:
                 continue                          # keep doorways clear
-            trial = scene_with([*scene.landmarks, item])
-            if _connected(trial):
-                scene = trial
-    return scene
+            free = floor_grid.with_landmark(item)
+            if floor_grid.connected(free):
+                items.append(item)
+                floor_grid.free = free
+    return scene_with(items)

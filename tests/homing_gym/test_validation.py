@@ -13,6 +13,9 @@ ENV = "homing_gym/LocalHoming-v0"
 
 @pytest.mark.parametrize("kwargs, words", [
     ({"scene": "moon"}, ["moon", "arena", "random_arena"]),
+    ({"scene": ["random_rooms", "random_nature"]}, ["['random_rooms', 'random_nature']",
+                                                   "homing-train"]),
+    ({"scene": 3}, ["unknown scene 3", "mesh:PATH"]),
     ({"panorama_shape": (4, 64)}, ["panorama_shape", "(4, 64)"]),
     ({"panorama_shape": (48, 0)}, ["panorama_shape"]),
     ({"vfov_deg": 179}, ["vfov"]),
