@@ -246,7 +246,12 @@ class SelfSimilarController(Controller):
     def check_env(self, env) -> None:
         """Note which world the episodes are in: the env's scene, by name (what an
         operator tells the robot, "you are in building X"; nothing of its layout, its
-        landmark changes or the robot's pose is read)."""
+        landmark changes or the robot's pose is read). A procedural scene draws another
+        world under the same name, so ``memory="world"`` refuses it (``ValueError``)."""
+        if self.memory == "world" and env.unwrapped.draws_worlds:
+            raise ValueError(f"selfsimilar: memory='world' keeps one map per scene name, "
+                             f"but scene {env.unwrapped.scene.name!r} draws a new world "
+                             f"each episode; use memory='episode'")
         self._world = str(env.unwrapped.scene.name)
 
     # -- memory -----------------------------------------------------------------------------

@@ -221,6 +221,13 @@ class HomingEnv(gym.Env):
 
     # -- helpers --------------------------------------------------------------------------
     @property
+    def draws_worlds(self) -> bool:
+        """Whether the scene is procedural: a new world is drawn on every seeded reset
+        (and every ``episodes_per_world`` unseeded ones), so a scene name does not name
+        one world."""
+        return self._scene_factory.randomised
+
+    @property
     def panorama(self) -> np.ndarray:
         """The panorama at the robot's current pose, rendered when first read after a
         move (observation keys ``panorama``, ``omni``, ``signature`` and the ``rgb_array``

@@ -258,3 +258,21 @@ def test_the_harness_names_the_world_and_each_world_keeps_its_own_map(make_env,
     first.observe(0, {1: (2.0, 0.5)})
     fresh.reset(seed=1)
     assert fresh.graph is not first and fresh.graph.edge(0, 1) is None
+
+
+def test_a_procedural_scene_is_refused_by_the_world_memory_and_taken_per_episode(
+        make_env, controller_for):
+    """A procedural scene draws another world under the same name: a map kept by name
+    would be carried into a different world, so memory="world" refuses it; memory="episode"
+    runs there."""
+    from homing_gym.scenes import SceneFactory, corridors_scene
+
+    drawn_anew = SceneFactory(build=lambda rng: corridors_scene(), randomised=True)
+    env = make_env("homing_gym/LandmarkNavigation-v0", scene=drawn_anew,
+                   obs_keys=("view", "goal_id", "odometry"))
+    assert env.unwrapped.draws_worlds
+    with pytest.raises(ValueError, match="memory='world'.*draws a new world.*memory='episode'"):
+        controller_for("selfsimilar", env)
+    controller_for("selfsimilar", env, memory="episode").reset(seed=0)
+    fixed = make_env("homing_gym/LandmarkNavigation-v0", obs_keys=("view", "goal_id", "odometry"))
+    assert not fixed.unwrapped.draws_worlds
