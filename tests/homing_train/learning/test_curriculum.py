@@ -1,5 +1,5 @@
-"""The start-distance (and success-radius) curriculum of homing-train: promotion on the success rate of the
-last finished episodes, the env hook it drives, and its settings' checks."""
+"""The start-distance (and success-radius) curriculum of homing-train: promotion on the
+success rate of the last finished episodes, the env hook it drives, and its settings' checks."""
 
 import json
 import math
