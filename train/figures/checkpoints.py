@@ -3,8 +3,9 @@ saw: every saved checkpoint of ``homing-train`` runs scored on a protocol.
 
 ``python -m homing_train.figures.checkpoints runs/A runs/B --protocol unseen --episodes 5 --every 50000 4096 --out docs/generalisation``
 
-scores ``RUN/checkpoints/ppo_<steps>_steps.zip`` (every ``--every`` steps; one value per run, or one for all) and, where
-the run has one, ``RUN/pretrain_model.zip`` (the warm start, drawn before step 0) on
+scores ``RUN/checkpoints/ppo_<steps>_steps.zip`` (every ``--every`` steps; one value per run, or one for all), the
+final ``RUN/model.zip`` and, where the run has one, ``RUN/pretrain_model.zip`` (the warm
+start, drawn before step 0) on
 ``--protocol`` with ``--episodes`` per setting, each with the settings recorded in the run
 (:func:`homing_train.harness.policies.recorded_settings`), the harness's stop rule and
 deterministic actions unless the run evaluated stochastically. Each checkpoint's cell is
@@ -16,6 +17,7 @@ seeds from ``evaluations.npz``) and ``checkpoints_<protocol>.md`` (the table).
 
 from __future__ import annotations
 
+import json
 import re
 import sys
 from dataclasses import dataclass
@@ -47,17 +49,27 @@ class CheckpointScore:
 
 
 def run_checkpoints(run: Path, every: int) -> list[tuple[int, Path]]:
-    """``(steps, zip)`` of the run's warm start (if any) and of its checkpoints whose
-    step count is a multiple of ``every``, in step order."""
+    """``(steps, zip)`` of the run's warm start (if any), of its checkpoints whose step
+    count is a multiple of ``every`` and of its final ``model.zip`` (at the steps in
+    ``summary.json``, where the run finished), in step order."""
     found = sorted((int(m.group(1)), p) for p in (run / "checkpoints").glob("ppo_*_steps.zip")
                    if (m := _CHECKPOINT.search(p.name)))
     chosen = [(s, p) for s, p in found if s % every == 0]
+    final = _final_steps(run)
+    if final is not None and (run / "model.zip").is_file() and all(s != final for s, _ in chosen):
+        chosen.append((final, run / "model.zip"))
     if (run / "pretrain_model.zip").is_file():
         chosen.insert(0, (PRETRAIN_STEP, run / "pretrain_model.zip"))
     if not chosen:
         raise ValueError(f"{run} has no checkpoints at multiples of {every} steps "
                          f"(found {[s for s, _ in found]}) and no pretrain_model.zip")
     return chosen
+
+
+def _final_steps(run: Path) -> int | None:
+    """Env steps of the run's final model, from ``summary.json`` (None without one)."""
+    path = run / "summary.json"
+    return json.loads(path.read_text()).get("timesteps") if path.is_file() else None
 
 
 def score_run(run: Path, protocol_name: str, episodes: int, every: int,
@@ -107,6 +119,7 @@ def plot(results: dict[str, list[CheckpointScore]], runs: dict[str, Path],
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import FuncFormatter
 
     fig, axes = plt.subplots(1, len(results), figsize=(4.2 * len(results), 3.6), dpi=150,
                              sharey=True, squeeze=False)
@@ -126,6 +139,7 @@ def plot(results: dict[str, list[CheckpointScore]], runs: dict[str, Path],
                     label="training worlds, held-out seeds")
         ax.set_title(name, fontsize=9)
         ax.set_xlabel("environment steps of PPO")
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda x, _: f"{x / 1000:g}k" if x else "0"))
         ax.set_ylim(-2, 102)
         ax.legend(fontsize=7, loc="upper right")
     axes[0][0].set_ylabel("success % (stopped within radius)")

@@ -1,5 +1,7 @@
 """Choosing a run's checkpoints and tabulating their scores (no episodes run)."""
 
+import json
+
 import pytest
 
 from homing_train.figures.checkpoints import (PRETRAIN_STEP, CheckpointScore, markdown,
@@ -19,6 +21,19 @@ def test_checkpoints_at_multiples_of_every_in_step_order_after_the_warm_start(tm
         PRETRAIN_STEP, 25000, 50000, 75000, 100000]
     with pytest.raises(ValueError, match="no checkpoints at multiples of 30000"):
         run_checkpoints(tmp_path / "checkpoints", every=30000)
+
+
+def test_the_final_model_closes_the_series_unless_a_checkpoint_has_its_steps(tmp_path):
+    (tmp_path / "checkpoints").mkdir()
+    for steps in (50000, 100000):
+        (tmp_path / "checkpoints" / f"ppo_{steps}_steps.zip").write_bytes(b"")
+    (tmp_path / "model.zip").write_bytes(b"")
+    (tmp_path / "summary.json").write_text(json.dumps({"timesteps": 120848}))
+    assert [(s, p.name) for s, p in run_checkpoints(tmp_path, every=50000)] == [
+        (50000, "ppo_50000_steps.zip"), (100000, "ppo_100000_steps.zip"),
+        (120848, "model.zip")]
+    (tmp_path / "summary.json").write_text(json.dumps({"timesteps": 100000}))
+    assert [s for s, _ in run_checkpoints(tmp_path, every=50000)] == [50000, 100000]
 
 
 def test_table_gives_success_with_interval_and_counts():
