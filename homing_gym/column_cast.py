@@ -90,11 +90,24 @@ def _column_segment(p: np.ndarray, c: float, s: float, seg: np.ndarray) -> bool:
     return True
 
 
+#: Largest tangent of a corner's bearing relative to the first corner that
+#: :func:`_span` bounds by the tangent itself instead of computing the angle.
+_SMALL_TANGENT = 0.05
+
+
 @njit(cache=True, error_model="numpy")
 def _span(p: np.ndarray, yaw: float):
     """Bearing span ``(lo, hi, everywhere)`` of the triangle's corners, relative to the
-    heading (radians, counter-clockwise; ``hi - lo < pi``); ``everywhere`` when the
-    camera's vertical line passes through the triangle. ``lo > hi``: seen edge-on."""
+    heading (radians, counter-clockwise; ``hi - lo < pi``), or an interval slightly
+    wider; ``everywhere`` when the camera's vertical line passes through the triangle.
+    ``lo > hi``: seen edge-on.
+
+    A corner's bearing relative to the first corner is ``atan(t)`` for the tangent
+    ``t = cross / dot`` of their directions; where ``|t|`` is small (a triangle that
+    looks narrow, as most of a detailed world's do) the interval takes ``t`` itself,
+    which is farther from 0 than ``atan(t)`` (by less than ``t**3 / 3``, under 5e-5 rad),
+    so no column inside the span is missed and one arctangent serves the triangle: the
+    caster tests each column of the interval exactly anyway."""
     c0 = p[0, 0] * p[1, 1] - p[0, 1] * p[1, 0]
     c1 = p[1, 0] * p[2, 1] - p[1, 1] * p[2, 0]
     c2 = p[2, 0] * p[0, 1] - p[2, 1] * p[0, 0]
@@ -102,23 +115,23 @@ def _span(p: np.ndarray, yaw: float):
         return 1.0, 0.0, False
     if (c0 >= 0 and c1 >= 0 and c2 >= 0) or (c0 <= 0 and c1 <= 0 and c2 <= 0):
         return -math.pi, math.pi, True
-    a0 = math.atan2(p[0, 1], p[0, 0])
     lo = hi = 0.0
     for k in range(1, 3):
-        d = math.atan2(p[k, 1], p[k, 0]) - a0
-        if d > math.pi:
-            d -= 2 * math.pi
-        elif d < -math.pi:
-            d += 2 * math.pi
+        cross = p[0, 0] * p[k, 1] - p[0, 1] * p[k, 0]
+        dot = p[0, 0] * p[k, 0] + p[0, 1] * p[k, 1]
+        if dot > 0.0 and abs(cross) <= _SMALL_TANGENT * dot:
+            d = cross / dot
+        else:
+            d = math.atan2(cross, dot)
         lo, hi = min(lo, d), max(hi, d)
-    a0 -= yaw
+    a0 = math.atan2(p[0, 1], p[0, 0]) - yaw
     return a0 + lo, a0 + hi, False
 
 
 @njit(cache=True, error_model="numpy")
 def cast_columns(tris: np.ndarray, normals: np.ndarray, closed: np.ndarray,
                  origin: np.ndarray, yaw: float, beta: np.ndarray, tan_elev: np.ndarray,
-                 hit: np.ndarray, weights: np.ndarray) -> None:
+                 hit: np.ndarray, weights: np.ndarray, depth: np.ndarray) -> None:
     """Nearest triangle per pixel.
 
     ``tris (N, 3, 3)`` world corners (metres); ``normals (N, 3)`` their normals;
@@ -128,10 +141,12 @@ def cast_columns(tris: np.ndarray, normals: np.ndarray, closed: np.ndarray,
     heading (radians); ``beta (W,)`` column bearings relative to the heading, strictly
     descending within ``(-pi, pi]``; ``tan_elev (H, W)`` tangent of each pixel's ray
     elevation, descending down each column. Writes ``hit (H, W)`` the triangle index
-    (``-1``: nothing) and ``weights (H, W, 3)`` the barycentric weights of the hit.
+    (``-1``: nothing) and ``weights (H, W, 3)`` the barycentric weights of the hit;
+    ``depth (W, H)`` is scratch (the nearest hit's horizontal distance so far, column by
+    column like the loops below), overwritten.
     """
     H, W = tan_elev.shape
-    depth = np.full((W, H), np.inf)           # column by column, like the loops below
+    depth[:] = np.inf
     hit[:] = -1
     cos_b = np.cos(yaw + beta)
     sin_b = np.sin(yaw + beta)
@@ -205,19 +220,25 @@ def _texel(atlas: np.ndarray, levels: np.ndarray, m: int, s: float, v: float,
 
 
 @njit(cache=True, error_model="numpy")
-def lit_colors(colors: np.ndarray, normals: np.ndarray, tris: np.ndarray, light: np.ndarray,
-               ambient: float, diffuse: float, origin: np.ndarray) -> np.ndarray:
-    """Each triangle's colour (``(N, 3)``) times ``ambient + diffuse * max(0, n . l)``
-    seen from ``origin``: Lambert with the unit light direction ``l``, ``n`` the
-    triangle's normal turned towards the camera (a face turned away from the light gets
-    the ambient term alone)."""
-    lit = np.empty((colors.shape[0], 3))
-    for t in range(colors.shape[0]):
-        towards = 0.0
+def lit_colors(colors: np.ndarray, normals: np.ndarray, tris: np.ndarray, closed: np.ndarray,
+               light: np.ndarray, ambient: float, diffuse: float, origin: np.ndarray,
+               which: np.ndarray, lit: np.ndarray) -> None:
+    """Writes ``lit[t]`` for each triangle ``t`` in ``which``: its colour times
+    ``ambient + diffuse * max(0, n . l)`` seen from ``origin``. Lambert with the unit
+    light direction ``l``, ``n`` the triangle's normal turned towards the camera (a face
+    turned away from the light gets the ambient term alone). A ``closed`` triangle is
+    only ever seen from outside (:func:`cast_columns` skips it otherwise), so its ``n``
+    is the outward normal wherever the camera is: its colour depends on the light alone
+    and can be kept from image to image."""
+    for t in which:
+        towards = 1.0
         cos_light = 0.0
         for d in range(3):
-            towards += normals[t, d] * (origin[d] - tris[t, 0, d])
             cos_light += normals[t, d] * light[d]
+        if not closed[t]:
+            towards = 0.0
+            for d in range(3):
+                towards += normals[t, d] * (origin[d] - tris[t, 0, d])
         if towards < 0.0:
             cos_light = -cos_light
         elif towards == 0.0:
@@ -225,7 +246,6 @@ def lit_colors(colors: np.ndarray, normals: np.ndarray, tris: np.ndarray, light:
         factor = ambient + diffuse * max(cos_light, 0.0)
         for c in range(3):
             lit[t, c] = colors[t, c] * factor
-    return lit
 
 
 #: float32 constants of the final quantisation (the same arithmetic as a float32 image

@@ -134,7 +134,12 @@ class RayCaster:
         #: Cast shadows (:mod:`homing_gym.shadows`); maps cached per light direction.
         self.shadows = shadows
         self._shadow_maps: dict[tuple, ShadowMap] = {}
-        self._scratch: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
+        self._scratch: dict[tuple[int, int], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        #: Lit triangle colours (:meth:`_lit`), for the light ``_lit_key``.
+        self._lit_colors = np.empty((len(self._tris), 3))
+        self._lit_key: tuple | None = None
+        self._all = np.arange(len(self._tris))
+        self._open = np.flatnonzero(~self._closed)
 
     def _shadow_map(self, lighting: Lighting) -> ShadowMap:
         key = tuple(lighting.direction)
@@ -142,13 +147,27 @@ class RayCaster:
             self._shadow_maps[key] = shadow_map(self._tris, lighting.direction)
         return self._shadow_maps[key]
 
-    def _buffers(self, H: int, W: int) -> tuple[np.ndarray, np.ndarray]:
+    def _lit(self, light: Lighting, origin: np.ndarray) -> np.ndarray:
+        """Each triangle's lit colour seen from ``origin`` (:func:`lit_colors`): those of
+        closed solids computed once per light, the open ones for every image."""
+        key = (tuple(light.direction), light.ambient, light.diffuse)
+        which = self._open
+        if self._lit_key != key:
+            self._lit_key, which = key, self._all
+        direction = np.asarray(light.direction, np.float64)
+        lit_colors(self.mesh.colors, self._normals, self._tris, self._closed,
+                   direction / np.linalg.norm(direction), light.ambient, light.diffuse,
+                   origin, which, self._lit_colors)
+        return self._lit_colors
+
+    def _buffers(self, H: int, W: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The caster's per-ray outputs for ``H x W`` rays (triangle index, barycentric
-        weights), kept between images; column-major, as the caster and the shader walk
-        the image column by column."""
+        weights) and its depth scratch, kept between images; column-major, as the caster
+        and the shader walk the image column by column."""
         if (H, W) not in self._scratch:
             self._scratch[(H, W)] = (np.empty((W, H), np.int32).T,
-                                     np.empty((W, H, 3)).transpose(1, 0, 2))
+                                     np.empty((W, H, 3)).transpose(1, 0, 2),
+                                     np.empty((W, H)))
         return self._scratch[(H, W)]
 
     def _image(self, pose, camera_height: float, rays, k: int, spacing: float,
@@ -156,18 +175,14 @@ class RayCaster:
         beta, tan_elev = rays
         x, y, yaw = (float(v) for v in pose)
         H, W = tan_elev.shape
-        hit, weights = self._buffers(H, W)
+        hit, weights, depth = self._buffers(H, W)
         origin = np.array([x, y, camera_height])
         cast_columns(self._tris, self._normals, self._closed, origin, yaw, beta, tan_elev,
-                     hit, weights)
+                     hit, weights, depth)
         image = np.empty((H // k, W // k, 3), np.uint8)
         light = lighting or DEFAULT_LIGHTING
         shadow = self._shadow_map(light) if self.shadows else _NO_SHADOWS
-        direction = np.asarray(light.direction, np.float64)
-        lit = lit_colors(self.mesh.colors, self._normals, self._tris,
-                         direction / np.linalg.norm(direction), light.ambient, light.diffuse,
-                         origin)
-        shade(hit, weights, lit, self._texture,
+        shade(hit, weights, self._lit(light, origin), self._texture,
               self._uvs, self._atlas, self._levels, self._first_level, self._texel_density,
               self._tris, self._normals, origin, spacing, self.sky, image,
               self.mesh.colors * light.ambient if self.shadows else self.mesh.colors,

@@ -6,8 +6,9 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from homing_gym.panorama import bearing_column
+from homing_gym.panorama import Lighting, bearing_column
 from homing_gym.perspective import PerspectiveConfig
+from homing_gym.raycast import RayCaster
 from homing_gym.scenes import Landmark, Scene, available_scenes
 from homing_gym.vision import luminance
 
@@ -78,6 +79,26 @@ def test_the_same_pose_gives_identical_pixels():
     assert np.array_equal(a, b)
 
 
+def test_an_image_does_not_depend_on_the_images_rendered_before_it():
+    """The caster keeps lit colours and buffers between images: a fresh caster, and one
+    that has just rendered elsewhere under another light, give the same pixels."""
+    env = gym.make("homing_gym/LocalHoming-v0", scene="house", renderer="raycast")
+    env.reset(seed=2)
+    u = env.unwrapped
+    caster, config = u.sim.caster, u.camera.config
+    fresh = RayCaster(caster.mesh, caster.sky)
+    env.close()
+    here, there = (0.5, 0.5, 0.3), (-1.0, 2.0, 2.0)
+    light = Lighting(direction=(-0.5, 0.8, 0.6), ambient=0.3, diffuse=0.8)
+    first = caster.panorama(here, 0.3, config)
+    caster.panorama(there, 0.3, config, light)
+    lit = caster.panorama(here, 0.3, config, light)
+    assert np.array_equal(caster.panorama(here, 0.3, config), first)
+    assert np.array_equal(fresh.panorama(here, 0.3, config, light), lit)
+    assert np.array_equal(fresh.panorama(here, 0.3, config), first)
+    assert not np.array_equal(lit, first)
+
+
 def test_perspective_view_puts_the_pole_where_the_pinhole_does():
     env = gym.make("homing_gym/LocalHoming-v0", scene=_pole_scene(2.0, 0.5),
                    renderer="raycast", start_distance=(0.3, 0.5))
@@ -144,7 +165,7 @@ def test_every_pixel_hits_what_embree_hits(scene):
             H, W = tan.shape
             hit, weights = np.empty((H, W), np.int64), np.empty((H, W, 3))
             cast_columns(tris, mesh.normals.astype(np.float64), mesh.closed, origin, yaw,
-                         beta, tan, hit, weights)
+                         beta, tan, hit, weights, np.empty((W, H)))
             cos_e = 1 / np.sqrt(1 + tan ** 2)
             dirs = np.stack([cos_e * np.cos(yaw + beta), cos_e * np.sin(yaw + beta),
                              cos_e * tan], -1).reshape(-1, 3).astype(np.float32)
