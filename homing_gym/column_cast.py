@@ -153,12 +153,13 @@ def cast_columns(tris: np.ndarray, normals: np.ndarray, closed: np.ndarray,
     p = np.empty((3, 3))
     seg = np.empty((2, 5))
     for t in range(tris.shape[0]):
+        if closed[t] and (normals[t, 0] * (tris[t, 0, 0] - origin[0])
+                          + normals[t, 1] * (tris[t, 0, 1] - origin[1])
+                          + normals[t, 2] * (tris[t, 0, 2] - origin[2])) >= 0.0:
+            continue
         for k in range(3):
             for d in range(3):
                 p[k, d] = tris[t, k, d] - origin[d]
-        if closed[t] and (normals[t, 0] * p[0, 0] + normals[t, 1] * p[0, 1]
-                          + normals[t, 2] * p[0, 2]) >= 0.0:
-            continue
         lo, hi, everywhere = _span(p, yaw)
         if lo > hi:
             continue

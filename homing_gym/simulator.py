@@ -35,6 +35,12 @@ from homing_gym.solids import (Solid, fence_solids, floor_rectangle, floor_top, 
 from homing_gym.textures import texture_path
 from homing_gym.worldmesh import world_mesh
 
+#: ``createMultiBody`` options of every static body (floor, walls, landmarks, mesh
+#: parts): a PyBullet rigid body rather than a fixed-base multibody, which the solver
+#: visits at every physics step (about 0.3 us a body a step: 28 against 18 us a step
+#: with 40 trees). Contacts and trajectories are bit for bit the same (checked on every
+#: built-in scene, both drives and 10,000-triangle worlds).
+_STATIC = {"useMaximalCoordinates": True}
 
 def _fixed_part(scene: Scene) -> tuple:
     """What a randomised scene may not change without a rebuild: the floor, the walls'
@@ -123,7 +129,7 @@ class Simulator:
         vis = (c.createVisualShape(p.GEOM_BOX, halfExtents=half, visualFramePosition=centre,
                                    rgbaColor=list(scene.floor_color))
                if scene.ground_plane and self._drawn else -1)
-        body = c.createMultiBody(0, col, vis, [0, 0, 0])
+        body = c.createMultiBody(0, col, vis, [0, 0, 0], **_STATIC)
         if scene.ground_plane:
             self._paint(body, scene.floor_color, scene.floor_texture)
         else:
@@ -148,7 +154,7 @@ class Simulator:
             col = c.createCollisionShape(p.GEOM_MESH, vertices=part.vertices.tolist(),
                                          indices=faces.ravel().tolist(),
                                          flags=p.GEOM_FORCE_CONCAVE_TRIMESH)
-            bodies.append(c.createMultiBody(0, col, -1, [0, 0, 0]))
+            bodies.append(c.createMultiBody(0, col, -1, [0, 0, 0], **_STATIC))
             self._hide(bodies[-1])
         if self._drawn:
             levels = np.round(part.face_colors * 16).astype(np.int64)
@@ -159,7 +165,7 @@ class Simulator:
                     p.GEOM_MESH, vertices=part.vertices.tolist(),
                     indices=group.ravel().tolist(),
                     rgbaColor=[*(levels[keys == key][0] / 16), 1.0])
-                bodies.append(c.createMultiBody(0, -1, vis, [0, 0, 0]))
+                bodies.append(c.createMultiBody(0, -1, vis, [0, 0, 0], **_STATIC))
                 c.changeVisualShape(bodies[-1], -1, textureUniqueId=-1)   # no default checker
         return bodies
 
@@ -183,7 +189,7 @@ class Simulator:
         elif visible:
             vis = c.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=list(solid.color))
         body = c.createMultiBody(0, col, vis, list(solid.centre),
-                                 c.getQuaternionFromEuler([0, 0, solid.yaw]))
+                                 c.getQuaternionFromEuler([0, 0, solid.yaw]), **_STATIC)
         if visible:
             self._paint(body, solid.color, solid.texture)
         else:
