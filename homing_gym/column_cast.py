@@ -26,26 +26,39 @@ from homing_gym.shadows import in_shadow
 NEAR = 1e-6
 
 
-@njit(cache=True, error_model="numpy")
-def _first_at_most(col: np.ndarray, j: int, value: float) -> int:
-    """First row ``i`` with ``col[i, j] <= value`` (rows descend), or ``len(col)``."""
-    lo, hi = 0, col.shape[0]
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if col[mid, j] <= value:
-            hi = mid
-        else:
-            lo = mid + 1
-    return lo
+@njit(cache=True, error_model="numpy", inline="always")
+def _past(v: float, value: float, strict: bool) -> bool:
+    return v < value if strict else v <= value
 
 
 @njit(cache=True, error_model="numpy")
-def _first_below(values: np.ndarray, value: float) -> int:
-    """First index ``j`` with ``values[j] < value`` (values descend), or ``len(values)``."""
-    lo, hi = 0, values.shape[0]
+def _first_past(values: np.ndarray, value: float, strict: bool, guess: int) -> int:
+    """First index ``i`` at which the descending ``values`` fall below ``value``
+    (``values[i] < value``, or ``<=`` when not ``strict``), or ``len(values)``.
+
+    Searched outward from ``guess`` in doubling steps, then by bisection, so a guess a
+    few places off costs a few steps; a negative ``guess``: plain bisection."""
+    n = values.shape[0]
+    lo, hi = 0, n
+    if guess >= 0:
+        g = min(guess, n)
+        if g == n or _past(values[g], value, strict):      # the answer is at most g
+            hi, step, lo = g, 1, g - 1
+            while lo >= 0 and _past(values[lo], value, strict):
+                hi = lo
+                step *= 2
+                lo = hi - step
+            lo = max(lo + 1, 0)
+        else:                                              # the answer is past g
+            lo, step = g + 1, 1
+            hi = lo
+            while hi < n and not _past(values[hi], value, strict):
+                lo = hi + 1
+                step *= 2
+                hi = min(lo + step - 1, n)
     while lo < hi:
         mid = (lo + hi) // 2
-        if values[mid] < value:
+        if _past(values[mid], value, strict):
             hi = mid
         else:
             lo = mid + 1
@@ -150,6 +163,8 @@ def cast_columns(tris: np.ndarray, normals: np.ndarray, closed: np.ndarray,
     hit[:] = -1
     cos_b = np.cos(yaw + beta)
     sin_b = np.sin(yaw + beta)
+    # columns per radian if evenly spaced: where the searches for a bearing start
+    per_radian = (W - 1) / (beta[0] - beta[W - 1]) if W > 1 else 0.0
     p = np.empty((3, 3))
     seg = np.empty((2, 5))
     for t in range(tris.shape[0]):
@@ -169,13 +184,18 @@ def cast_columns(tris: np.ndarray, normals: np.ndarray, closed: np.ndarray,
             if not everywhere and (hi + shift + 1e-12 <= beta[W - 1]
                                    or lo + shift - 1e-12 > beta[0]):
                 continue          # no column in this turn of the span: skip the searches
-            j0 = _first_below(beta, hi + shift + 1e-12) if not everywhere else 0
-            j1 = _first_below(beta, lo + shift - 1e-12) if not everywhere else W
+            j0, j1 = 0, W
+            if not everywhere:
+                j0 = _first_past(beta, hi + shift + 1e-12, True,
+                                 int(max((beta[0] - hi - shift) * per_radian, 0.0)))
+                j1 = _first_past(beta, lo + shift - 1e-12, True,
+                                 int(max((beta[0] - lo - shift) * per_radian, 0.0)))
+            i0 = -1                  # the row where the previous column's segment began
             for j in range(j0, j1):
                 if not _column_segment(p, cos_b[j], sin_b[j], seg):
                     continue
                 ta, tb = seg[0, 1] / seg[0, 0], seg[1, 1] / seg[1, 0]
-                i0 = _first_at_most(tan_elev, j, max(ta, tb))
+                i0 = _first_past(tan_elev[:, j], max(ta, tb), False, i0)
                 for i in range(i0, H):
                     ti = tan_elev[i, j]
                     if ti < min(ta, tb):

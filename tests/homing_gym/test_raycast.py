@@ -8,6 +8,7 @@ import pytest
 
 from homing_gym.panorama import Lighting, bearing_column
 from homing_gym.perspective import PerspectiveConfig
+from homing_gym.column_cast import _first_past
 from homing_gym.raycast import RayCaster
 from homing_gym.scenes import Landmark, Scene, available_scenes
 from homing_gym.vision import luminance
@@ -97,6 +98,17 @@ def test_an_image_does_not_depend_on_the_images_rendered_before_it():
     assert np.array_equal(fresh.panorama(here, 0.3, config, light), lit)
     assert np.array_equal(fresh.panorama(here, 0.3, config), first)
     assert not np.array_equal(lit, first)
+
+
+def test_the_caster_search_finds_the_first_value_past_a_bound_from_any_guess():
+    rng = np.random.default_rng(0)
+    for _ in range(3000):
+        values = np.sort(rng.integers(0, 10, int(rng.integers(1, 40))).astype(float))[::-1]
+        bound, strict = float(rng.integers(-1, 11)), bool(rng.integers(0, 2))
+        past = values < bound if strict else values <= bound
+        first = int(np.argmax(past)) if past.any() else len(values)
+        for guess in (-1, 0, first, len(values) // 2, len(values), len(values) + 7):
+            assert _first_past(values, bound, strict, guess) == first
 
 
 def test_perspective_view_puts_the_pole_where_the_pinhole_does():
@@ -203,7 +215,8 @@ def test_cast_shadows_darken_the_floor_behind_an_object_and_nothing_else(make_en
     """A 1 m box at the origin, the light from +x at 45 degrees: the floor from x = -0.2
     to about -1.2 m (|y| < 0.5) lies in its shadow and gets the ambient light alone."""
     from homing_gym.panorama import CameraConfig, Lighting
-    from homing_gym.raycast import RayCaster
+    from homing_gym.column_cast import _first_past
+from homing_gym.raycast import RayCaster
     from homing_gym.worldmesh import world_mesh
 
     scene = Scene("block", ((-3, -3), (3, 3)),
