@@ -214,9 +214,7 @@ def test_camera_height_and_sky_color():
 def test_cast_shadows_darken_the_floor_behind_an_object_and_nothing_else(make_env):
     """A 1 m box at the origin, the light from +x at 45 degrees: the floor from x = -0.2
     to about -1.2 m (|y| < 0.5) lies in its shadow and gets the ambient light alone."""
-    from homing_gym.panorama import CameraConfig, Lighting
-    from homing_gym.column_cast import _first_past
-from homing_gym.raycast import RayCaster
+    from homing_gym.panorama import CameraConfig
     from homing_gym.worldmesh import world_mesh
 
     scene = Scene("block", ((-3, -3), (3, 3)),
