@@ -194,23 +194,30 @@ def cast_columns(tris: np.ndarray, normals: np.ndarray, closed: np.ndarray,
             for j in range(j0, j1):
                 if not _column_segment(p, cos_b[j], sin_b[j], seg):
                     continue
-                ta, tb = seg[0, 1] / seg[0, 0], seg[1, 1] / seg[1, 0]
+                # the segment's ends in locals: the loop below stores to arrays the
+                # compiler cannot tell apart from ``seg``, so it would reload them
+                a0, h0, a1, h1 = seg[0, 0], seg[0, 1], seg[1, 0], seg[1, 1]
+                w0, w1, w2 = seg[0, 2], seg[0, 3], seg[0, 4]
+                da, dw0, dw1, dw2 = a1 - a0, seg[1, 2] - w0, seg[1, 3] - w1, seg[1, 4] - w2
+                ta, tb = h0 / a0, h1 / a1
+                lowest = min(ta, tb)
                 i0 = _first_past(tan_elev[:, j], max(ta, tb), False, i0)
                 for i in range(i0, H):
                     ti = tan_elev[i, j]
-                    if ti < min(ta, tb):
+                    if ti < lowest:
                         break
-                    fa = seg[0, 1] - ti * seg[0, 0]
-                    fb = seg[1, 1] - ti * seg[1, 0]
+                    fa = h0 - ti * a0
+                    fb = h1 - ti * a1
                     if fa == fb:
                         continue
                     u = min(max(fa / (fa - fb), 0.0), 1.0)
-                    dist = seg[0, 0] + u * (seg[1, 0] - seg[0, 0])
+                    dist = a0 + u * da
                     if dist < depth[j, i]:
                         depth[j, i] = dist
                         hit[i, j] = t
-                        for k in range(3):
-                            weights[i, j, k] = seg[0, 2 + k] + u * (seg[1, 2 + k] - seg[0, 2 + k])
+                        weights[i, j, 0] = w0 + u * dw0
+                        weights[i, j, 1] = w1 + u * dw1
+                        weights[i, j, 2] = w2 + u * dw2
 
 
 @njit(cache=True, error_model="numpy", inline="always")
