@@ -315,10 +315,10 @@ def shade(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.nd
     mean = np.float32(1.0 / (k * k))
     shadows = shadow_depth.size > 0
     near, far = np.empty(3), np.empty(3)
-    acc = np.empty(3, np.float32)
+    zero = np.float32(0.0)
     for jo in range(cols):
         for io in range(rows):
-            acc[:] = 0.0
+            acc_r, acc_g, acc_b = zero, zero, zero        # in registers, not an array
             for i in range(io * k, io * k + k):
                 for j in range(jo * k, jo * k + k):
                     t = hit[i, j]
@@ -370,8 +370,9 @@ def shade(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.nd
                                     near[c] = (1 - frac) * near[c] + frac * far[c]
                             r, g, b = r * near[0], g * near[1], b * near[2]
                         r, g, b = min(max(r, 0.0), 1.0), min(max(g, 0.0), 1.0), min(max(b, 0.0), 1.0)
-                    acc[0] += np.float32(r)
-                    acc[1] += np.float32(g)
-                    acc[2] += np.float32(b)
-            for c in range(3):
-                out[io, jo, c] = np.uint8(acc[c] * mean * _SCALE_255 + _HALF)
+                    acc_r += np.float32(r)
+                    acc_g += np.float32(g)
+                    acc_b += np.float32(b)
+            out[io, jo, 0] = np.uint8(acc_r * mean * _SCALE_255 + _HALF)
+            out[io, jo, 1] = np.uint8(acc_g * mean * _SCALE_255 + _HALF)
+            out[io, jo, 2] = np.uint8(acc_b * mean * _SCALE_255 + _HALF)
