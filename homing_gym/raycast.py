@@ -138,6 +138,7 @@ class RayCaster:
         #: Lit triangle colours (:meth:`_lit`), for the light ``_lit_key``.
         self._lit_colors = np.empty((len(self._tris), 3))
         self._lit_key: tuple | None = None
+        self._light = np.zeros(3)            # the unit light direction of ``_lit_key``
         self._all = np.arange(len(self._tris))
         self._open = np.flatnonzero(~self._closed)
 
@@ -153,11 +154,11 @@ class RayCaster:
         key = (tuple(light.direction), light.ambient, light.diffuse)
         which = self._open
         if self._lit_key != key:
-            self._lit_key, which = key, self._all
-        direction = np.asarray(light.direction, np.float64)
-        lit_colors(self.mesh.colors, self._normals, self._tris, self._closed,
-                   direction / np.linalg.norm(direction), light.ambient, light.diffuse,
-                   origin, which, self._lit_colors)
+            direction = np.asarray(light.direction, np.float64)
+            self._lit_key, self._light = key, direction / np.linalg.norm(direction)
+            which = self._all
+        lit_colors(self.mesh.colors, self._normals, self._tris, self._closed, self._light,
+                   light.ambient, light.diffuse, origin, which, self._lit_colors)
         return self._lit_colors
 
     def _buffers(self, H: int, W: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
