@@ -42,6 +42,7 @@ from homing_gym.worldmesh import world_mesh
 #: built-in scene, both drives and 10,000-triangle worlds).
 _STATIC = {"useMaximalCoordinates": True}
 
+
 def _fixed_part(scene: Scene) -> tuple:
     """What a randomised scene may not change without a rebuild: the floor, the walls'
     geometry and the fence."""
