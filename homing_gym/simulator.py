@@ -13,7 +13,6 @@ Physics: ``time_step`` (the env's default 1/120 s) per ``stepSimulation``; the e
 from __future__ import annotations
 
 import functools
-import math
 import os
 import pkgutil
 import sys
