@@ -92,7 +92,7 @@ def per_scene_figure(results: dict[str, list[SceneResult]], path: Path) -> None:
     labels = [_scene(r.label) for r in next(iter(results.values()))]
     counts = sorted({len(r.episodes) for rows in results.values() for r in rows})
     width = 0.8 / len(results)
-    fig, ax = plt.subplots(figsize=(max(7.0, 1.4 * len(labels)), 3.8), dpi=150)
+    fig, ax = plt.subplots(figsize=(max(7.0, 1.9 * len(labels)), 3.8), dpi=150)
     for k, (method, rows) in enumerate(results.items()):
         x = np.arange(len(rows)) + (k - (len(results) - 1) / 2) * width
         rate = np.array([r.successes / len(r.episodes) for r in rows])
@@ -105,11 +105,11 @@ def per_scene_figure(results: dict[str, list[SceneResult]], path: Path) -> None:
     ax.set_ylim(0, 100)
     ax.set_title(f"{'/'.join(map(str, counts))} episodes per bar, Wilson 95 % intervals",
                  fontsize=8)
-    ax.legend(fontsize=7, ncol=len(results), loc="upper center", bbox_to_anchor=(0.5, -0.1),
-              frameon=False)
+    ax.legend(fontsize=7, ncol=(len(results) + 1) // 2, loc="upper center",
+              bbox_to_anchor=(0.5, -0.1), frameon=False)
     ax.spines[["top", "right"]].set_visible(False)
     fig.tight_layout()
-    fig.savefig(path)
+    fig.savefig(path, bbox_inches="tight")
     plt.close(fig)
 
 
