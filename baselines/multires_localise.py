@@ -22,11 +22,17 @@ point, so the search is sized for that range, ``reach`` = 0.5 m):
 * (2-3) windows: the prediction (2-2) is exact only at the taught point; from anywhere
   within ``reach`` a point at distance ``d`` appears up to ``asin(reach/d)`` away in
   bearing and correspondingly in elevation (parallax, :func:`parallax_windows`: about
-  +-45 columns for a point 1 m away, +-16 for one 3.5 m away), plus ``margin`` for the
-  low-resolution heading; and up to ``d/(d-reach)`` times larger or ``d/(d+reach)``
+  +-45 columns for a point 1 m away, +-16 for one 3.5 m away), plus ``heading_margin``
+  for the error of the low-resolution heading (2-1) (parallax moves the whole view too:
+  within 0.5 m of the `house`'s work locations that heading was off by a median 2.6-4.9
+  deg and at most 13.7 deg, so the default is 15 deg) and ``margin`` pixels; and up to
+  ``d/(d-reach)`` times larger or ``d/(d+reach)``
   smaller, so each template is also tried at the powers of 2^(1/4) in that range
   (:func:`search_scales`; the paper's own arrival decision, Fig. 5, compares enlarged
-  and reduced images the same way) and the best correlation counts;
+  and reduced images the same way) and the best correlation counts; where an enlarged
+  template reaches past the image's top or bottom edge, its rows inside the image are
+  correlated (:func:`~homing_baselines.multires_matching.find_template`: the nearest
+  pictures, half a metre away, appear at the top edge of the 60 deg view);
 * the pose is fitted to the pair of points that most others agree with (within
   ``outlier`` radians; all pairs are tried, there are at most 45; among equally many,
   the smallest sum of residuals) and refitted on those; a pose more than
@@ -61,7 +67,8 @@ class LocaliseConfig:
     the view correlated in (2-1) (default the whole panorama: the robot's camera sees
     all around, where the paper's robot turned its head), ``reach`` (m): how far from
     the work location the robot may stand (it sizes the first windows and scales),
-    ``margin`` and ``fine_radius`` (half sizes in full-resolution pixels: columns,
+    ``heading_margin`` (rad): how far off the coarse heading (2-1) may be, ``margin``
+    and ``fine_radius`` (half sizes in full-resolution pixels: columns,
     rows), ``fine_passes``, the normalised-correlation ``threshold`` of a
     rediscovery, the ``outlier`` residual (rad) and ``max_offset`` (m): a pose further
     than this from the work location is rejected as a false rediscovery."""
@@ -70,6 +77,7 @@ class LocaliseConfig:
     vfov: float = np.radians(60.0)
     fov: float = 2 * np.pi
     reach: float = 0.5
+    heading_margin: float = np.radians(15.0)
     margin: tuple[int, int] = (4, 2)
     fine_radius: tuple[int, int] = (4, 3)
     fine_passes: int = 3
@@ -97,7 +105,8 @@ def _distances(fmap: FeatureMap, xy) -> np.ndarray:
 def parallax_windows(fmap: FeatureMap, shape, config: LocaliseConfig) -> np.ndarray:
     """Half sizes ``(N, 2)`` (full-resolution columns, rows) of the first (2-3) search
     windows: how far each point's image can move from its taught position (1-3) when the
-    robot stands anywhere within ``reach`` metres of the work location, plus ``margin``."""
+    robot stands anywhere within ``reach`` metres of the work location, plus
+    ``heading_margin`` in bearing and ``margin``."""
     H, W = shape
     d = _distances(fmap, fmap.pose)
     rise = fmap.points[:, 2] - config.camera_height
@@ -105,7 +114,8 @@ def parallax_windows(fmap: FeatureMap, shape, config: LocaliseConfig) -> np.ndar
     bearing = np.arcsin(np.minimum(1.0, config.reach / d))
     elevation = np.maximum(np.abs(np.arctan2(rise, near) - np.arctan2(rise, d)),
                            np.abs(np.arctan2(rise, d + config.reach) - np.arctan2(rise, d)))
-    return np.column_stack([np.ceil(bearing * W / (2 * np.pi)) + config.margin[0],
+    return np.column_stack([np.ceil((bearing + config.heading_margin) * W / (2 * np.pi))
+                            + config.margin[0],
                             np.ceil(elevation * H / config.vfov) + config.margin[1]]).astype(int)
 
 

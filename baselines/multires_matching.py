@@ -132,23 +132,34 @@ class TemplateMatch:
 
 def find_template(image: np.ndarray, template: np.ndarray, x: float, y: float,
                   radius: tuple[int, int]) -> TemplateMatch | None:
-    """Search grey ``template`` (odd size) in the grey panorama ``image`` with its centre
-    within ``radius = (columns, rows)`` of the continuous point ``(x, y)`` (columns
-    wrap); rows of the window beyond the image are cut off (the template stays inside
-    the image). ``None`` if no row of the window keeps the template inside."""
+    """Search grey ``template`` (odd size ``t``) in the grey panorama ``image`` with its
+    centre within ``radius = (columns, rows)`` of the continuous point ``(x, y)`` (columns
+    wrap). Rows of the window beyond the image are cut off; where the centre is inside
+    the image but the template reaches past its top or bottom, only the template's rows
+    inside the image are correlated (a point near the edge of the view is still a point
+    in view). ``None`` if no row of the window lies in the image."""
     t = template.shape[0]
     H, W = image.shape[:2]
     rx, ry = radius
     r = t // 2
     cx, cy = int(math.floor(x)), int(math.floor(y))
-    first, last = max(cy - ry, r), min(cy + ry, H - 1 - r)     # rows of the centre
+    first, last = max(cy - ry, 0), min(cy + ry, H - 1)     # rows of the centre
     if first > last:
         return None
     pad = rx + r + 1
     left = cx - rx - r + pad
-    window = _wrap_pad(image, pad)[first - r:last + r + 1, left:left + 2 * rx + t]
-    scores = cv2.matchTemplate(window.astype(np.float32), template.astype(np.float32),
-                               cv2.TM_CCOEFF_NORMED)
+    strip = _wrap_pad(image, pad)[:, left:left + 2 * rx + t].astype(np.float32)
+    template = template.astype(np.float32)
+    scores = np.full((last - first + 1, 2 * rx + 1), -np.inf, np.float32)
+    inner_first, inner_last = max(first, r), min(last, H - 1 - r)
+    if inner_first <= inner_last:                            # the whole template inside
+        scores[inner_first - first:inner_last - first + 1] = cv2.matchTemplate(
+            strip[inner_first - r:inner_last + r + 1], template, cv2.TM_CCOEFF_NORMED)
+    for row in [*range(first, min(r, last + 1)), *range(max(H - r, first), last + 1)]:
+        top, bottom = max(row - r, 0), min(row + r + 1, H)  # the template's rows inside
+        part = template[top - (row - r):bottom - (row - r)]
+        scores[row - first] = cv2.matchTemplate(strip[top:bottom], part,
+                                                cv2.TM_CCOEFF_NORMED)[0]
     j, i = np.unravel_index(int(np.argmax(scores)), scores.shape)
     dx = _subpixel(scores[j, :], i)
     dy = _subpixel(scores[:, i], j)

@@ -1,9 +1,9 @@
 """Figures and numbers of docs/multires.md (Shiraishi & Sawasaki multi-resolution matching).
 
 ``python -m homing_train.figures.multires localisation --out docs/multires``: self-localisation
-(§4(2-2), Fig. 10) at every point of a grid (``--spacing``, default 0.2 m: with 0.1,
-TinyRenderer stalls on one bedroom pose) within 0.5 m of each work location of the
-``house`` and several headings, with and without daily changes; error distributions
+(§4(2-2), Fig. 10) at every point of a grid (``--spacing``, default 0.2 m) within 0.5 m
+of each work location of the ``house`` and several headings (``--headings``), or at
+``--random-poses N`` seeded random poses per location, with and without daily changes; error distributions
 (``localisation.png``), summary (``localisation.json``) and localisations per second on
 one core (the ``localise`` call alone, and with rendering the panorama).
 
@@ -55,36 +55,55 @@ def grid_offsets(radius: float = 0.5, spacing: float = 0.1) -> np.ndarray:
     return xy[np.hypot(xy[:, 0], xy[:, 1]) <= radius + 1e-9]
 
 
+def _poses(fmap: FeatureMap, fits, spacing: float, headings: int, random_poses: int,
+           rng: np.random.Generator) -> list[np.ndarray]:
+    """Poses (x, y, yaw) within 0.5 m of the work location where ``fits(xy)``: a grid
+    with ``spacing`` at ``headings`` headings from the taught one, or, with
+    ``random_poses`` > 0, that many uniform in the disc with uniform headings."""
+    x0, y0, yaw0 = fmap.pose
+    if random_poses == 0:
+        return [np.array([x0 + dx, y0 + dy, yaw0 + 2 * math.pi * k / headings])
+                for dx, dy in grid_offsets(0.5, spacing) if fits((x0 + dx, y0 + dy))
+                for k in range(headings)]
+    poses = []
+    while len(poses) < random_poses:
+        r, a = 0.5 * math.sqrt(rng.uniform()), rng.uniform(0, 2 * math.pi)
+        xy = (x0 + r * math.cos(a), y0 + r * math.sin(a))
+        if fits(xy):
+            poses.append(np.array([*xy, rng.uniform(0, 2 * math.pi)]))
+    return poses
+
+
 def localisation_experiment(daily_changes: float, spacing: float, headings: int,
-                            seed: int = 0) -> list[dict]:
-    """One row per (location, grid point where the robot's body fits, heading): errors
+                            seed: int = 0, random_poses: int = 0) -> list[dict]:
+    """One row per (location, pose where the robot's body fits; :func:`_poses`): errors
     in cm and degrees."""
     rows = []
     gym.register_envs(homing_gym)
+    rng = np.random.default_rng(seed)
     for name in LOCATIONS:
         env = gym.make(ENV_ID, goal_location=name, daily_changes=daily_changes, **MEASURED_WITH)
         obs, _ = env.reset(seed=seed)
         fmap, u = _feature_map(obs), env.unwrapped
-        for dx, dy in grid_offsets(0.5, spacing):
-            xy = (fmap.pose[0] + dx, fmap.pose[1] + dy)
-            if clearance(u.scene, xy) < u.robot_config.body_radius:
-                continue
-            for k in range(headings):
-                pose = np.array([fmap.pose[0] + dx, fmap.pose[1] + dy,
-                                 fmap.pose[2] + 2 * math.pi * k / headings])
-                t0 = time.process_time()
-                pano = u.render_panorama(pose)
-                t1 = time.process_time()
-                result = localise(pano, fmap)
-                t2 = time.process_time()
-                row = {"location": name, "offset": [float(dx), float(dy)],
-                       "heading": float(pose[2]), "found": result.found,
-                       "render_s": t1 - t0, "localise_s": t2 - t1, "ok": result.pose is not None}
-                if result.pose is not None:
-                    row["error_cm"] = 100 * math.dist(result.pose[:2], pose[:2])
-                    row["heading_error_deg"] = math.degrees(
-                        abs(math.remainder(result.pose[2] - pose[2], 2 * math.pi)))
-                rows.append(row)
+
+        def fits(xy) -> bool:
+            return clearance(u.scene, xy) >= u.robot_config.body_radius
+
+        for pose in _poses(fmap, fits, spacing, headings, random_poses, rng):
+            t0 = time.process_time()
+            pano = u.render_panorama(pose)
+            t1 = time.process_time()
+            result = localise(pano, fmap)
+            t2 = time.process_time()
+            row = {"location": name, "offset": [float(pose[0] - fmap.pose[0]),
+                                                float(pose[1] - fmap.pose[1])],
+                   "heading": float(pose[2]), "found": result.found,
+                   "render_s": t1 - t0, "localise_s": t2 - t1, "ok": result.pose is not None}
+            if result.pose is not None:
+                row["error_cm"] = 100 * math.dist(result.pose[:2], pose[:2])
+                row["heading_error_deg"] = math.degrees(
+                    abs(math.remainder(result.pose[2] - pose[2], 2 * math.pi)))
+            rows.append(row)
         env.close()
     return rows
 
@@ -146,6 +165,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", default="docs/multires")
     parser.add_argument("--spacing", type=float, default=0.2, help="grid spacing (m)")
     parser.add_argument("--headings", type=int, default=4)
+    parser.add_argument("--random-poses", type=int, default=0,
+                        help="localisation: this many seeded random poses per work location "
+                             "(uniform in the 0.5 m disc, any heading) instead of the grid")
     parser.add_argument("--episodes", type=int, default=30)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--daily-changes", type=float, default=0.0)
@@ -159,7 +181,8 @@ def main(argv: list[str] | None = None) -> int:
         results = {}
         fig, axes = plt.subplots(1, 2, figsize=(9, 3.5))
         for label, changes in (("as taught", 0.0), ("daily changes 1.0", 1.0)):
-            rows = localisation_experiment(changes, args.spacing, args.headings, args.seed)
+            rows = localisation_experiment(changes, args.spacing, args.headings, args.seed,
+                                            args.random_poses)
             results[label] = {"summary": summarise_localisation(rows), "rows": rows}
             ok = [r for r in rows if r["ok"]]
             _cdf(axes[0], [r["error_cm"] for r in ok], label)
