@@ -60,6 +60,7 @@ from homing_baselines.bearing_sim import (ReachabilityMap, SimConfig, circumcirc
                                    reachability_map, region)
 from homing_gym.cli import command_parser  # noqa: E402
 from homing_train.figures import MEASURED_WITH  # noqa: E402
+from homing_train.harness.policies import parse_params  # noqa: E402
 
 #: The landmark triangle of the figures (m): scalene, about 2 m a side.
 LANDMARKS = np.array([[-1.0, -0.6], [1.2, -0.5], [0.2, 1.1]])
@@ -426,7 +427,7 @@ def pixel_reachability(out: str, spacing: float = 1.2, max_steps: int = 600,
 
 
 def lab_anywhere(out: str, episodes: int = 40, seed: int = 0, max_steps: int = 800,
-                 progress: bool = True) -> dict:
+                 progress: bool = True, params: dict | None = None) -> dict:
     """The unified law (``bearing``) in ``LocalHoming-v0`` in the lab with the env's own
     homes (anywhere in the room) and starts (0.3-1.5 m away), seeds ``seed`` ... ``seed +
     episodes - 1``, a success being a stop within the env's 0.15 m. Each episode is also
@@ -436,7 +437,8 @@ def lab_anywhere(out: str, episodes: int = 40, seed: int = 0, max_steps: int = 8
     ``near_circle``: the home lies within 0.1 m of the circle ``C^``
     (left out of the reachability tables: the snapshot barely fixes the position there);
     ``goal_landmarks``: poster colours seen in the goal panorama (the laws need three).
-    Writes ``lab_anywhere.json``; returns the counts."""
+    ``params``: the controller's parameters other than its defaults. Writes
+    ``lab_anywhere.json``; returns the counts."""
     import gymnasium as gym
 
     import homing_baselines
@@ -453,7 +455,7 @@ def lab_anywhere(out: str, episodes: int = 40, seed: int = 0, max_steps: int = 8
     centre, radius = circumcircle(triangle)
     scene = env.unwrapped.scene
     body = env.unwrapped.robot_config.body_radius
-    controller = homing_baselines.make("bearing")
+    controller = homing_baselines.make("bearing", **(params or {}))
     prepare_policy(controller, env)
     runs: list[dict] = []
     for s in tqdm(range(seed, seed + episodes), desc="lab, homes anywhere",
@@ -471,7 +473,8 @@ def lab_anywhere(out: str, episodes: int = 40, seed: int = 0, max_steps: int = 8
                      "steps": record.steps, "collisions": record.collisions})
         os.makedirs(out, exist_ok=True)
         with open(os.path.join(out, "lab_anywhere.json"), "w") as f:
-            json.dump({"seed": seed, "max_steps": max_steps, "counts": anywhere_counts(runs),
+            json.dump({"seed": seed, "max_steps": max_steps, "params": params or {},
+                       "counts": anywhere_counts(runs),
                        "runs": runs}, f, indent=1)
     env.close()
     return anywhere_counts(runs)
@@ -608,6 +611,8 @@ def main(argv: list[str] | None = None) -> int:
     la.add_argument("--episodes", type=int, default=40)
     la.add_argument("--seed", type=int, default=0, help="seed of the first episode")
     la.add_argument("--max-steps", type=int, default=800)
+    la.add_argument("--param", action="append", metavar="KEY=VALUE",
+                    help="a parameter of the bearing controller (repeatable)")
     la.add_argument("--no-progress", action="store_true")
     lr = sub.add_parser("longrange", help="bearing-longrange on LongRangeHoming-v0")
     lr.add_argument("--out", default="docs/bearing", help="output folder")
@@ -629,7 +634,8 @@ def main(argv: list[str] | None = None) -> int:
               f"within 10 cm {within}/{len(rows)}")
     elif args.command == "lab-anywhere":
         counts = lab_anywhere(args.out, args.episodes, args.seed, args.max_steps,
-                              progress=not args.no_progress)
+                              progress=not args.no_progress,
+                              params=parse_params(args.param, "bearing"))
         print(json.dumps(counts))
     elif args.command == "fig10":
         runs = fig10(args.out, args.max_steps, args.fail_cm, progress=not args.no_progress)
