@@ -193,3 +193,20 @@ def test_home_localised_where_a_near_picture_reaches_past_the_top_of_the_view(ma
     assert result.pose is not None
     assert math.dist(result.pose[:2], pose[:2]) < 0.10
     assert abs(math.remainder(result.pose[2] - pose[2], 2 * math.pi)) < math.radians(2)
+
+
+def test_random_localisation_poses_lie_in_the_disc_where_the_robot_fits():
+    from homing_train.figures.multires import _poses
+
+    fmap = _feature_map([[1.0, 0.0, 0.5], [0.0, 1.0, 0.5]], pose=(2.0, 3.0, 0.4))
+    def east_half(xy):
+        return xy[0] >= 2.0
+    poses = _poses(fmap, east_half, 0.1, 4, 50, np.random.default_rng(0))
+    assert len(poses) == 50
+    offsets = np.array([p[:2] for p in poses]) - [2.0, 3.0]
+    assert np.all(np.hypot(*offsets.T) <= 0.5) and np.all(offsets[:, 0] >= 0)
+    assert np.ptp([p[2] for p in poses]) > math.pi                # headings spread
+    grid = _poses(fmap, east_half, 0.25, 2, 0, np.random.default_rng(0))
+    assert len(grid) == 2 * 9            # 9 of the 13 grid points have x >= 0 (5 + 3 + 1)
+    with pytest.raises(ValueError, match="fits at fewer than 5"):
+        _poses(fmap, lambda xy: False, 0.1, 4, 5, np.random.default_rng(0))

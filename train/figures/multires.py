@@ -3,8 +3,8 @@
 ``python -m homing_train.figures.multires localisation --out docs/multires``: self-localisation
 (§4(2-2), Fig. 10) at every point of a grid (``--spacing``, default 0.2 m) within 0.5 m
 of each work location of the ``house`` and several headings (``--headings``), or at
-``--random-poses N`` seeded random poses per location, with and without daily changes; error distributions
-(``localisation.png``), summary (``localisation.json``) and localisations per second on
+``--random-poses N`` seeded random poses per location, with and without daily changes;
+error distributions (``localisation.png``), summary (``localisation.json``) and localisations per second on
 one core (the ``localise`` call alone, and with rendering the panorama).
 
 ``python -m homing_train.figures.multires travel --episodes 30 --out docs/multires``: seeded
@@ -66,12 +66,15 @@ def _poses(fmap: FeatureMap, fits, spacing: float, headings: int, random_poses: 
                 for dx, dy in grid_offsets(0.5, spacing) if fits((x0 + dx, y0 + dy))
                 for k in range(headings)]
     poses = []
-    while len(poses) < random_poses:
+    for _ in range(100 * random_poses):
         r, a = 0.5 * math.sqrt(rng.uniform()), rng.uniform(0, 2 * math.pi)
         xy = (x0 + r * math.cos(a), y0 + r * math.sin(a))
         if fits(xy):
             poses.append(np.array([*xy, rng.uniform(0, 2 * math.pi)]))
-    return poses
+            if len(poses) == random_poses:
+                return poses
+    raise ValueError(f"the robot fits at fewer than {random_poses} of {100 * random_poses} "
+                     f"random positions within 0.5 m of the work location {tuple(fmap.pose[:2])}")
 
 
 def localisation_experiment(daily_changes: float, spacing: float, headings: int,
@@ -172,6 +175,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--daily-changes", type=float, default=0.0)
     args = parser.parse_args(argv)
+    if not (args.spacing > 0 and args.headings >= 1 and args.random_poses >= 0):
+        parser.error(f"need --spacing > 0 m, --headings >= 1 and --random-poses >= 0, got "
+                     f"{args.spacing}, {args.headings}, {args.random_poses}")
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
