@@ -24,7 +24,7 @@ point, so the search is sized for that range, ``reach`` = 0.5 m):
   bearing and correspondingly in elevation (parallax, :func:`parallax_windows`: about
   +-45 columns for a point 1 m away, +-16 for one 3.5 m away), plus ``heading_margin``
   for the error of the low-resolution heading (2-1) (parallax moves the whole view too:
-  within 0.5 m of the `house`'s work locations that heading was off by a median 2.6-4.9
+  within 0.5 m of the ``house``'s work locations that heading was off by a median 2.6-4.9
   deg and at most 13.7 deg, so the default is 15 deg) and ``margin`` pixels; and up to
   ``d/(d-reach)`` times larger or ``d/(d+reach)``
   smaller, so each template is also tried at the powers of 2^(1/4) in that range
