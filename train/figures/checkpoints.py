@@ -49,19 +49,25 @@ class CheckpointScore:
 
 
 def run_checkpoints(run: Path, every: int) -> list[tuple[int, Path]]:
-    """``(steps, zip)`` of the run's warm start (if any), of its checkpoints whose step
-    count is a multiple of ``every`` and of its final ``model.zip`` (at the steps in
-    ``summary.json``, where the run finished), in step order."""
+    """``(steps, zip)`` of the run's warm start (if any), of its checkpoints spaced by
+    ``every`` steps (the first at ``every`` or later, then each at least ``every`` past
+    the last one taken: the multiples of ``every`` where the run saved them, and still
+    evenly spread after a resume shifted its checkpoints) and of its final
+    ``model.zip`` (at the steps in ``summary.json``, where the run finished), in step
+    order."""
     found = sorted((int(m.group(1)), p) for p in (run / "checkpoints").glob("ppo_*_steps.zip")
                    if (m := _CHECKPOINT.search(p.name)))
-    chosen = [(s, p) for s, p in found if s % every == 0]
+    chosen: list[tuple[int, Path]] = []
+    for steps, path in found:
+        if steps - (chosen[-1][0] if chosen else 0) >= every:
+            chosen.append((steps, path))
     final = _final_steps(run)
     if final is not None and (run / "model.zip").is_file() and all(s != final for s, _ in chosen):
         chosen.append((final, run / "model.zip"))
     if (run / "pretrain_model.zip").is_file():
         chosen.insert(0, (PRETRAIN_STEP, run / "pretrain_model.zip"))
     if not chosen:
-        raise ValueError(f"{run} has no checkpoints at multiples of {every} steps "
+        raise ValueError(f"{run} has no checkpoints at {every} steps or later "
                          f"(found {[s for s, _ in found]}) and no pretrain_model.zip")
     return chosen
 
@@ -156,8 +162,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--protocol", default="unseen", choices=sorted(PROTOCOLS))
     parser.add_argument("--episodes", type=int, default=5, help="episodes per setting")
     parser.add_argument("--every", type=int, nargs="+", default=[50000],
-                        help="score the checkpoints at multiples of this many steps (one "
-                             "value for every run, or one per run)")
+                        help="score checkpoints this many steps apart (one value for "
+                             "every run, or one per run)")
     parser.add_argument("--out", type=Path, default=Path("docs/generalisation"))
     parser.add_argument("--no-progress", action="store_true")
     args = parser.parse_args(argv)

@@ -8,7 +8,7 @@ from homing_train.figures.checkpoints import (PRETRAIN_STEP, CheckpointScore, ma
                                               run_checkpoints)
 
 
-def test_checkpoints_at_multiples_of_every_in_step_order_after_the_warm_start(tmp_path):
+def test_checkpoints_every_so_many_steps_in_step_order_after_the_warm_start(tmp_path):
     (tmp_path / "checkpoints").mkdir()
     for steps in (100000, 25000, 50000, 75000):
         (tmp_path / "checkpoints" / f"ppo_{steps}_steps.zip").write_bytes(b"")
@@ -19,8 +19,19 @@ def test_checkpoints_at_multiples_of_every_in_step_order_after_the_warm_start(tm
     (tmp_path / "pretrain_model.zip").write_bytes(b"")
     assert [s for s, _ in run_checkpoints(tmp_path, every=25000)] == [
         PRETRAIN_STEP, 25000, 50000, 75000, 100000]
-    with pytest.raises(ValueError, match="no checkpoints at multiples of 30000"):
-        run_checkpoints(tmp_path / "checkpoints", every=30000)
+    assert [s for s, _ in run_checkpoints(tmp_path, every=30000)] == [PRETRAIN_STEP, 50000,
+                                                                      100000]
+    with pytest.raises(ValueError, match="no checkpoints at 200000 steps or later"):
+        run_checkpoints(tmp_path / "checkpoints", every=200000)
+
+
+def test_checkpoints_stay_spread_after_a_resume_shifted_them(tmp_path):
+    (tmp_path / "checkpoints").mkdir()
+    steps = [25000 * k for k in range(1, 21)] + [543744 + 25000 * k for k in range(4)]
+    for s in steps:
+        (tmp_path / "checkpoints" / f"ppo_{s}_steps.zip").write_bytes(b"")
+    chosen = [s for s, _ in run_checkpoints(tmp_path, every=50000)]
+    assert chosen == [50000 * k for k in range(1, 11)] + [568744, 618744]
 
 
 def test_the_final_model_closes_the_series_unless_a_checkpoint_has_its_steps(tmp_path):
