@@ -155,7 +155,8 @@ def find_template(image: np.ndarray, template: np.ndarray, x: float, y: float,
     if inner_first <= inner_last:                            # the whole template inside
         scores[inner_first - first:inner_last - first + 1] = cv2.matchTemplate(
             strip[inner_first - r:inner_last + r + 1], template, cv2.TM_CCOEFF_NORMED)
-    for row in [*range(first, min(r, last + 1)), *range(max(H - r, first), last + 1)]:
+    below = min(r, last + 1)                                 # rows cut at the top: [first, below)
+    for row in [*range(first, below), *range(max(H - r, first, below), last + 1)]:
         top, bottom = max(row - r, 0), min(row + r + 1, H)  # the template's rows inside
         part = template[top - (row - r):bottom - (row - r)]
         scores[row - first] = cv2.matchTemplate(strip[top:bottom], part,
