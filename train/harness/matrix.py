@@ -35,6 +35,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Sequence
 
+import gymnasium as gym
 import matplotlib
 
 matplotlib.use("Agg")
@@ -94,17 +95,22 @@ def cell_methods(protocol: Protocol) -> list[str]:
 POLICY_OWN = ("renderer", "physics_substeps", "supersampling")
 
 
-def equal_time_kwargs(setting_kwargs: dict, recorded: dict) -> dict:
+def equal_time_kwargs(setting_kwargs: dict, recorded: dict, default_steps: int | None) -> dict:
     """A shipped policy's recorded env kwargs under a setting's: the setting wins, except
     that the policy keeps its own renderer and physics (:data:`POLICY_OWN`: what it was
-    trained with, until it is retrained) and a step cap counted at :data:`BASE_PERIOD`
-    becomes the same time at the policy's control period."""
+    trained with, until it is retrained), and every row gets the same time: the
+    setting's step cap, or where it sets none the env id's registered one
+    (``default_steps``; ``None``: no cap), counted at :data:`BASE_PERIOD`, becomes the
+    same time at the policy's control period. The cap the policy was trained with (in
+    ``recorded``) is never used: it would give a policy more or less time than the
+    controllers beside it."""
     merged = {**recorded, **setting_kwargs,
               **{key: recorded[key] for key in POLICY_OWN if key in recorded}}
-    period = float(recorded.get("control_period", BASE_PERIOD))
-    if "max_episode_steps" in setting_kwargs and period != BASE_PERIOD:
-        merged["max_episode_steps"] = max(1, round(setting_kwargs["max_episode_steps"]
-                                                   * BASE_PERIOD / period))
+    steps = setting_kwargs.get("max_episode_steps", default_steps)
+    merged.pop("max_episode_steps", None)
+    if steps is not None:
+        period = float(recorded.get("control_period", BASE_PERIOD))
+        merged["max_episode_steps"] = max(1, round(steps * BASE_PERIOD / period))
     return merged
 
 
@@ -140,7 +146,8 @@ def run_cell(protocol: Protocol, method: str, out: Path, episodes: int | None = 
         kwargs = setting.kwargs()
         if method in shipped:
             policy, params = str(shipped[method].path), shipped[method].params
-            kwargs = equal_time_kwargs(kwargs, shipped[method].env_kwargs)
+            kwargs = equal_time_kwargs(kwargs, shipped[method].env_kwargs,
+                                       gym.spec(setting.env_id).max_episode_steps)
         else:
             policy, params = method, {}
         stem = out / setting_stem(setting.label)

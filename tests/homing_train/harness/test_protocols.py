@@ -53,18 +53,22 @@ def test_bekris_starts_are_half_to_three_metres_from_each_marked_goal():
 
 
 def test_a_policy_with_a_longer_control_period_gets_the_same_time():
-    recorded = {"control_period": 0.2, "max_episode_steps": 250, "panorama_shape": [32, 128]}
+    recorded = {"control_period": 0.2, "max_episode_steps": 200, "panorama_shape": [32, 128]}
     merged = equal_time_kwargs({"scene": "arena", "max_episode_steps": 300,
-                                "success_on": "stop"}, recorded)
+                                "success_on": "stop"}, recorded, 500)
     assert merged["max_episode_steps"] == 150 and merged["panorama_shape"] == [32, 128]
     assert merged["scene"] == "arena" and merged["success_on"] == "stop"
-    assert equal_time_kwargs({"scene": "lab"}, recorded)["max_episode_steps"] == 250
+    # no cap in the setting: the env id's 500 steps of 0.1 s, not the 200 it trained with
+    assert equal_time_kwargs({"scene": "lab"}, recorded, 500)["max_episode_steps"] == 250
+    assert "max_episode_steps" not in equal_time_kwargs({"scene": "lab"}, recorded, None)
+    same_period = equal_time_kwargs({"scene": "lab"}, {"max_episode_steps": 200}, 500)
+    assert same_period["max_episode_steps"] == 500
 
 
 def test_a_policy_keeps_its_own_renderer_and_physics():
     recorded = {"renderer": "tiny", "physics_substeps": 24, "panorama_shape": [32, 128]}
     merged = equal_time_kwargs({"scene": "random_rooms", "renderer": "raycast",
-                                "physics_substeps": 12, "success_on": "stop"}, recorded)
+                                "physics_substeps": 12, "success_on": "stop"}, recorded, 500)
     assert merged["renderer"] == "tiny" and merged["physics_substeps"] == 24
     assert merged["scene"] == "random_rooms"
 
