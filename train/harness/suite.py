@@ -5,7 +5,8 @@
 
 Evaluates every registered scripted controller made for the env (:func:`suite_methods`)
 and every shipped PPO policy trained on it (``train/shipped/*.zip`` with the evaluation
-settings of its ``*.yml``: ``eval_env_kwargs``, ``eval_params``) with the same harness
+settings of its ``*.yml``: ``eval_env_kwargs``, ``eval_params``, and the controllers'
+time: :func:`~homing_train.harness.matrix.equal_time_kwargs`) with the same harness
 on the same seeded episodes (episode ``i`` uses seed ``seed + i``), writes one
 ``<method>.json``/``.csv`` per method into ``--out``, then runs ``homing-compare`` on them:
 ``table.md`` (printed), ``success_vs_distance.png``, ``final_distance.png`` and
@@ -33,7 +34,7 @@ from homing_train.extras import missing_extra
 from homing_train.harness.compare import compare
 from homing_train.harness.evaluate import (DEFAULT_ENV, add_backend_arguments, evaluate,
                                            format_summary)
-from homing_train.harness.matrix import matrix_markdown, run_matrix
+from homing_train.harness.matrix import equal_time_kwargs, matrix_markdown, run_matrix
 from homing_train.harness.policies import shipped_policies
 from homing_train.harness.protocols import PROTOCOLS, protocol
 
@@ -67,8 +68,10 @@ def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: in
     paths = []
     for name in chosen:
         shipped = policies.get(name)
-        policy, kwargs, params = (str(shipped.path), shipped.env_kwargs, shipped.params) \
-            if shipped else (name, {}, {})
+        policy, kwargs, params = (
+            str(shipped.path),
+            equal_time_kwargs({}, shipped.env_kwargs, gym.spec(env_id).max_episode_steps),
+            shipped.params) if shipped else (name, {}, {})
         result = evaluate(policy, env_id, episodes=episodes, seed=seed, env_kwargs=kwargs,
                           workers=workers, params=params, backend=backend, address=address)
         print(format_summary(result))

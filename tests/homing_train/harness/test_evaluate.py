@@ -243,6 +243,24 @@ def test_missing_training_extra_is_one_line_and_the_suite_runs_without_it(monkey
     assert not (tmp_path / "ppo_localhoming.json").exists()
 
 
+def test_the_suite_gives_a_shipped_policy_the_controllers_time(monkeypatch, tmp_path):
+    """ppo_procedural trained with 200 steps of 0.2 s; beside the controllers' 500 steps
+    of 0.1 s it gets 250 of its own, not the 200 of its record."""
+    from homing_train.harness import suite
+
+    seen = {}
+
+    def fake_evaluate(policy, env_id, env_kwargs=None, **kwargs):
+        seen[policy] = dict(env_kwargs or {})
+        raise KeyboardInterrupt          # the arguments are all this test needs
+
+    monkeypatch.setattr(suite, "evaluate", fake_evaluate)
+    with pytest.raises(KeyboardInterrupt):
+        suite.run_suite(tmp_path, episodes=1, workers=1, methods=["ppo_procedural"])
+    (kwargs,) = seen.values()
+    assert kwargs["control_period"] == 0.2 and kwargs["max_episode_steps"] == 250
+
+
 def _without_wall_time(result):
     return [{k: v for k, v in dataclasses.asdict(e).items() if k != "wall_time"}
             for e in result.episodes]
