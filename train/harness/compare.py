@@ -27,6 +27,7 @@ import numpy as np  # noqa: E402
 from homing_gym.cli import command_parser  # noqa: E402
 from homing_gym.topdown import MapCanvas, draw_pose, draw_scale_bar, draw_scene  # noqa: E402
 from homing_train.harness.evaluate import EvalResult  # noqa: E402
+from homing_train.harness.matrix import episode_seconds  # noqa: E402
 from homing_train.harness.palette import (HOME_MARK, START_MARK, method_color,  # noqa: E402
                                           method_color_255)
 
@@ -61,7 +62,8 @@ NEUTRAL_KEYS = ("obs_keys",)
 
 
 def settings_notes(results: Sequence[EvalResult]) -> list[str]:
-    """Lines saying where the rows' envs differ: the renderer, and the settings of rows
+    """Lines saying where the rows' envs differ: the renderer, the time an episode may
+    last (:func:`~homing_train.harness.matrix.episode_seconds`), and the settings of rows
     that depart from the most common ones (a shipped policy's own, by design)."""
     notes = []
     renderers: dict[str, list[str]] = {}
@@ -70,6 +72,13 @@ def settings_notes(results: Sequence[EvalResult]) -> list[str]:
     if len(renderers) > 1:
         notes.append("rows differ in renderer: " + "; ".join(
             f"{name} ({', '.join(rows)})" for name, rows in renderers.items()))
+    times: dict[str, list[str]] = {}
+    for r in results:
+        seconds = episode_seconds(r.env_id, r.env_kwargs)
+        times.setdefault("no limit" if seconds is None else f"{seconds:g} s", []).append(r.policy)
+    if len(times) > 1:
+        notes.append("rows differ in time per episode: " + "; ".join(
+            f"{name} ({', '.join(rows)})" for name, rows in times.items()))
     def key(r: EvalResult) -> str:
         return repr((r.env_id, sorted((k, v) for k, v in r.env_kwargs.items()
                                       if k not in NEUTRAL_KEYS)))

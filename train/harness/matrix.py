@@ -95,6 +95,15 @@ def cell_methods(protocol: Protocol) -> list[str]:
 POLICY_OWN = ("renderer", "physics_substeps", "supersampling")
 
 
+def episode_seconds(env_id: str, env_kwargs: dict) -> float | None:
+    """Simulated seconds an episode may last: its step cap (``env_kwargs``' or the env
+    id's registered one) times its control period; ``None`` without a cap."""
+    steps = env_kwargs.get("max_episode_steps", gym.spec(env_id).max_episode_steps)
+    if steps is None or steps < 0:
+        return None
+    return steps * float(env_kwargs.get("control_period", BASE_PERIOD))
+
+
 def equal_time_kwargs(setting_kwargs: dict, recorded: dict, default_steps: int | None) -> dict:
     """A shipped policy's recorded env kwargs under a setting's: the setting wins, except
     that the policy keeps its own renderer and physics (:data:`POLICY_OWN`: what it was

@@ -348,3 +348,8 @@ def test_compare_notes_say_which_rows_differ_in_renderer_and_settings():
     assert notes[1] == ("ppo runs with other env settings: panorama_shape=[32, 128], "
                         "physics_substeps=24, renderer='tiny'")
     assert settings_notes(rows[:2]) == []          # obs_keys change no episode
+    slow = result("ppo", **same, control_period=0.2, max_episode_steps=200)
+    assert settings_notes(rows[:2] + [slow])[0] == (
+        "rows differ in time per episode: 50 s (oracle, distance); 40 s (ppo)")
+    same_time = result("ppo", **same, control_period=0.2, max_episode_steps=250)
+    assert not any("time" in n for n in settings_notes(rows[:2] + [same_time]))
