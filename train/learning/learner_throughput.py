@@ -124,6 +124,7 @@ def measure_learner(policy_path: str, device: str, n_envs: int, n_steps: int, ba
     inference on batches of ``n_envs`` and ``PPO.learn`` for ``steps`` env steps (at
     least one rollout) on a :class:`FreeVecEnv`."""
     from stable_baselines3 import PPO
+    from stable_baselines3.common.logger import Logger
 
     from homing_train.learning.policy_zip import load_policy
 
@@ -139,6 +140,7 @@ def measure_learner(policy_path: str, device: str, n_envs: int, n_steps: int, ba
     env = FreeVecEnv(n_envs, loaded.observation_space, loaded.action_space, seed=seed)
     model = PPO(type(net), env, n_steps=n_steps, batch_size=batch_size, n_epochs=n_epochs,
                 target_kl=None, policy_kwargs=policy_kwargs, device=device, seed=seed, verbose=0)
+    model.set_logger(Logger(None, []))     # SB3's default makes a folder in /tmp per run
     steps = max(steps, n_steps * n_envs)
     model.learn(n_steps * n_envs, progress_bar=False)         # warm-up: kernels, allocator
     rates = measure(env, model, steps, f"{device}, {n_envs} envs, batch {batch_size}")

@@ -78,6 +78,9 @@ def measure(env, model, steps: int, label: str) -> Throughput:
     for _ in range(rounds):
         model.predict(obs, deterministic=False)
     inference = rounds * n_envs / (time.perf_counter() - t0)
+    from stable_baselines3.common.logger import Logger
+
+    model.set_logger(Logger(None, []))       # SB3's default makes a folder in /tmp per run
     timer = _rollout_timer()
     t0 = time.perf_counter()
     model.learn(steps, callback=timer, progress_bar=False)

@@ -2,6 +2,7 @@
 
 import subprocess
 import sys
+import tempfile
 from importlib import resources
 
 import numpy as np
@@ -32,7 +33,8 @@ def test_free_envs_serve_observations_of_the_spaces_and_end_episodes_on_time():
     assert done_at == [5, 10]
 
 
-def test_measured_rates_follow_from_the_timed_run():
+def test_measured_rates_follow_from_the_timed_run(tmp_path, monkeypatch):
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))     # where SB3 would log
     row = measure_learner(SHIPPED, "cpu", n_envs=2, n_steps=16, batch_size=16, n_epochs=2,
                           steps=64)
     assert row.timesteps == 64                       # two rollouts of 16 x 2
@@ -42,6 +44,7 @@ def test_measured_rates_follow_from_the_timed_run():
     assert r.ppo_steps_per_s == pytest.approx(64 / (r.rollout_s + r.update_s))
     assert row.update_samples_per_s == pytest.approx(64 * 2 / r.update_s)
     assert row.update_cap == pytest.approx(64 / r.update_s)
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith("SB3-")]  # no log folders
 
 
 def test_bad_settings_are_refused(capsys):
