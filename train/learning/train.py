@@ -63,6 +63,7 @@ class TrainConfig:
     timesteps: int = 300_000
     n_envs: int = 2
     vec: str = "subproc"
+    workers: int | None = None        # subprocesses for "subproc" (None: one per env)
     device: str = "cpu"
     torch_threads: int = 1
     extractor: str = "panorama"
@@ -90,6 +91,10 @@ class TrainConfig:
                              f"{list(homing_gym.ENV_IDS)} (or register yours, --import MODULE)")
         if self.vec not in ("subproc", "dummy"):
             raise ValueError(f"--vec must be 'subproc' or 'dummy', got {self.vec!r}")
+        if self.workers is not None and not (isinstance(self.workers, int)
+                                             and 1 <= self.workers <= self.n_envs):
+            raise ValueError(f"workers must be an integer from 1 to n_envs ({self.n_envs}), "
+                             f"got {self.workers!r}")
         if self.extractor not in EXTRACTORS:
             raise ValueError(f"unknown extractor {self.extractor!r}; allowed: {EXTRACTORS}")
         for key in ("timesteps", "n_envs", "eval_freq", "eval_episodes", "checkpoint_freq",
@@ -254,15 +259,23 @@ def worker_error(report_dir: Path) -> EnvWorkerError | None:
 def make_vec(config: TrainConfig, n_envs: int, seed: int, report_dir: Path | None = None):
     """A monitored vector env of ``n_envs`` envs (env ``i``: :meth:`TrainConfig.env_kwargs_of`
     ``(i)``, seed ``seed + i``; success logged from ``is_success``), images transposed to
-    channel-first; subprocess workers write their errors to ``report_dir``."""
+    channel-first; subprocess workers write their errors to ``report_dir``. With
+    ``vec="subproc"``, one process per env, or ``config.workers`` processes each stepping
+    a group of envs (:class:`~homing_train.learning.grouped_vec_env.GroupedSubprocVecEnv`)."""
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecTransposeImage
 
-    vec_cls, vec_kwargs = DummyVecEnv, {}
-    if config.vec == "subproc" and n_envs > 1:
-        vec_cls, vec_kwargs = SubprocVecEnv, {"start_method": "spawn"}
+    from homing_train.learning.grouped_vec_env import GroupedSubprocVecEnv
+
     report = None if report_dir is None else str(report_dir)
-    env = vec_cls([partial(make_monitored_env, config.env_id, config.env_kwargs_of(rank), report)
-                   for rank in range(n_envs)], **vec_kwargs)
+    fns = [partial(make_monitored_env, config.env_id, config.env_kwargs_of(rank), report)
+           for rank in range(n_envs)]
+    workers = min(config.workers or n_envs, n_envs)
+    if config.vec == "dummy" or n_envs == 1:
+        env = DummyVecEnv(fns)
+    elif workers < n_envs:
+        env = GroupedSubprocVecEnv(fns, workers, start_method="spawn")
+    else:
+        env = SubprocVecEnv(fns, start_method="spawn")
     env.seed(seed)
     return VecTransposeImage(env)      # channel-first images, as SB3 would wrap them itself
 
@@ -579,7 +592,9 @@ def _benchmark(parser, config: TrainConfig, steps: int) -> int:
     shape = "x".join(map(str, shape)) if isinstance(shape, (list, tuple)) else shape
     label = (f"{config.env_id.split('/')[-1]} {config.env_kwargs.get('scene', '')} {shape} "
              f"{sim['renderer']}, {config.extractor}, n_epochs {config.ppo.get('n_epochs')}, "
-             f"batch {config.ppo.get('batch_size')}, {config.vec}")
+             f"batch {config.ppo.get('batch_size')}, {config.vec}"
+             + (f" in {config.workers} workers" if config.vec == "subproc" and config.workers
+                else ""))
     torch.set_num_threads(config.torch_threads)
     try:
         env = make_vec(config, config.n_envs, config.seed)
