@@ -65,6 +65,8 @@ def _rollout_timer():
 def measure(env, model, steps: int, label: str) -> Throughput:
     """Measure a vectorised ``env`` and a PPO ``model`` built on it (as ``homing-train``
     builds them) over ``steps`` env steps, each of the three parts; closes nothing."""
+    from stable_baselines3.common.logger import Logger
+
     n_envs = env.num_envs
     rounds = max(steps // n_envs, 1)
     env.reset()
@@ -78,8 +80,6 @@ def measure(env, model, steps: int, label: str) -> Throughput:
     for _ in range(rounds):
         model.predict(obs, deterministic=False)
     inference = rounds * n_envs / (time.perf_counter() - t0)
-    from stable_baselines3.common.logger import Logger
-
     model.set_logger(Logger(None, []))       # SB3's default makes a folder in /tmp per run
     timer = _rollout_timer()
     t0 = time.perf_counter()
