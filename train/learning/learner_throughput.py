@@ -127,10 +127,12 @@ def measure_learner(policy_path: str, device: str, n_envs: int, n_steps: int, ba
     from stable_baselines3.common.logger import Logger
 
     from homing_train.learning.policy_zip import load_policy
+    from homing_train.learning.ppo_settings import check_device
 
     if min(n_envs, n_steps, batch_size, n_epochs) < 1:
         raise ValueError(f"n_envs, n_steps, batch_size and n_epochs must be at least 1, got "
                          f"{n_envs}, {n_steps}, {batch_size}, {n_epochs}")
+    check_device(device)
     loaded = load_policy(policy_path)
     net = loaded.policy
     policy_kwargs = {"net_arch": net.net_arch, "activation_fn": net.activation_fn,

@@ -123,3 +123,23 @@ def ppo_arguments(ppo: dict[str, Any]) -> dict[str, Any]:
         policy["activation_fn"] = getattr(torch.nn, ACTIVATIONS[policy["activation_fn"]])
     out["policy_kwargs"] = policy
     return out
+
+
+def check_device(device: str) -> None:
+    """Raise ``ValueError`` unless ``device`` is ``"auto"`` or a torch device this machine
+    has. SB3 alone would quietly train on the CPU when ``"cuda"`` is asked for and torch
+    sees no GPU, and fail deep inside torch on a misspelt name."""
+    import torch
+
+    if device == "auto":
+        return
+    try:
+        kind = torch.device(device).type
+    except (RuntimeError, TypeError):
+        raise ValueError(f"device {device!r} is not a torch device; use 'cpu', 'cuda', "
+                         f"'cuda:N', 'mps' or 'auto'") from None
+    available = {"cpu": True, "cuda": torch.cuda.is_available(),
+                 "mps": torch.backends.mps.is_available()}
+    if not available.get(kind, False):
+        raise ValueError(f"device {device!r}: torch {torch.__version__} sees no such device "
+                         f"on this machine (a CPU-only build?); use 'cpu' or 'auto'")

@@ -45,7 +45,7 @@ from homing_train.learning import EXTRACTORS
 from homing_train.learning.curriculum import (HOOK, CurriculumSettings, last_stage, mark_stages,
                                               plot_training_success)
 from homing_train.learning.imitation import dagger
-from homing_train.learning.ppo_settings import PPO_KEYS, check_ppo, ppo_arguments
+from homing_train.learning.ppo_settings import PPO_KEYS, check_device, check_ppo, ppo_arguments
 from homing_train.learning.pretrain import pretrain
 
 HYPERPARAMS = Path(str(resources.files("homing_train.learning") / "hyperparams" / "ppo.yml"))
@@ -117,6 +117,7 @@ class TrainConfig:
             raise ValueError(f"eval_deterministic must be true or false, got "
                              f"{self.eval_deterministic!r}")
         check_ppo(self.ppo, self.n_envs)
+        check_device(self.device)
         if self.curriculum is not None:
             CurriculumSettings.from_value(self.curriculum)
         scenes = self.env_kwargs.get("scene")

@@ -51,6 +51,9 @@ def test_bad_settings_are_refused(capsys):
     with pytest.raises(ValueError, match="at least 1"):
         measure_learner(SHIPPED, "cpu", n_envs=0, n_steps=16, batch_size=16, n_epochs=1,
                         steps=16)
+    with pytest.raises(ValueError, match="not a torch device"):
+        measure_learner(SHIPPED, "gpu0", n_envs=1, n_steps=16, batch_size=16, n_epochs=1,
+                        steps=16)
     with pytest.raises(SystemExit):
         main(["--policy", SHIPPED, "--n-envs", "1", "--batch-size", "512"])
     assert "larger than a rollout" in capsys.readouterr().err

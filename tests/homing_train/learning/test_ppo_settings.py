@@ -80,3 +80,22 @@ def test_state_dependent_exploration_needs_continuous_actions():
             new_model(config, env)
     finally:
         env.close()
+
+
+def test_the_device_must_exist_here(capsys, tmp_path, monkeypatch):
+    """SB3 would quietly train on the CPU when 'cuda' is missing: refused up front."""
+    from homing_train.learning.ppo_settings import check_device
+    from homing_train.learning.train import main
+
+    check_device("cpu")
+    check_device("auto")
+    with pytest.raises(ValueError, match="'cdua' is not a torch device"):
+        make_config(LOCAL, {"device": "cdua"})
+    monkeypatch.setattr(torch.cuda, "is_available", lambda: False)
+    with pytest.raises(ValueError, match="'cuda:1': torch .* sees no such device"):
+        check_device("cuda:1")
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit):
+        main(["--device", "cuda", "--timesteps", "64"])
+    assert "sees no such device" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []                  # no run folder left behind
