@@ -377,7 +377,8 @@ def test_a_bad_env_setting_is_one_error_and_leaves_no_run_folder(tmp_path, capsy
 
 
 @pytest.mark.slow
-def test_an_env_error_in_a_subprocess_worker_is_said_once_not_as_eoferror(tmp_path):
+@pytest.mark.parametrize("grouping", [[], ["--hp", "workers=1"]], ids=["per-env", "grouped"])
+def test_an_env_error_in_a_subprocess_worker_is_said_once_not_as_eoferror(tmp_path, grouping):
     import os
     import subprocess
     import sys
@@ -401,7 +402,8 @@ def test_an_env_error_in_a_subprocess_worker_is_said_once_not_as_eoferror(tmp_pa
     tiny[tiny.index("--n-envs") + 1] = "2"
     done = subprocess.run([sys.executable, "-m", "homing_train.learning.train", "--import",
                            "failing_env", "--env", "failing/LocalHoming-v0", "--timesteps", "64",
-                           "--out", str(run), *tiny], capture_output=True, text=True, env=env,
+                           "--out", str(run), *tiny, *grouping], capture_output=True,
+                          text=True, env=env,
                           timeout=300)
     assert done.returncode == 2, done.stderr[-2000:]
     assert done.stderr.count("boom: the user env failed at step 5") == 1, done.stderr[-3000:]
