@@ -103,19 +103,14 @@ class LearnerThroughput:
     rates: Throughput
 
     @property
-    def samples_per_update(self) -> int:
-        """Env steps collected per rollout (``n_steps x n_envs``)."""
-        return self.n_steps * self.n_envs
+    def update_cap(self) -> float:
+        """Env steps per second PPO could take if rollouts cost nothing at all."""
+        return self.timesteps / max(self.rates.update_s, 1e-9)
 
     @property
     def update_samples_per_s(self) -> float:
         """Samples through forward, backward and Adam per second during updates."""
-        return self.timesteps * self.n_epochs / max(self.rates.update_s, 1e-9)
-
-    @property
-    def update_cap(self) -> float:
-        """Env steps per second PPO could take if rollouts cost nothing at all."""
-        return self.update_samples_per_s / self.n_epochs
+        return self.update_cap * self.n_epochs
 
 
 def measure_learner(policy_path: str, device: str, n_envs: int, n_steps: int, batch_size: int,

@@ -38,7 +38,6 @@ def test_measured_rates_follow_from_the_timed_run(tmp_path, monkeypatch):
     row = measure_learner(SHIPPED, "cpu", n_envs=2, n_steps=16, batch_size=16, n_epochs=2,
                           steps=64)
     assert row.timesteps == 64                       # two rollouts of 16 x 2
-    assert row.samples_per_update == 32
     r = row.rates
     assert min(r.inference_per_s, r.ppo_steps_per_s, r.rollout_s, r.update_s) > 0
     assert r.ppo_steps_per_s == pytest.approx(64 / (r.rollout_s + r.update_s))
