@@ -25,6 +25,16 @@ def _free_start(env, home, distance, angle, heading, margin=0.25):
     raise AssertionError("no free start")
 
 
+@pytest.fixture(autouse=True, scope="session")
+def sb3_log_folder(tmp_path_factory):
+    """SB3's default logger (a ``learn()`` without ``set_logger``) writes into pytest's
+    temporary folder instead of leaving an ``SB3-<date>`` folder in the system's."""
+    mp = pytest.MonkeyPatch()
+    mp.setenv("SB3_LOGDIR", str(tmp_path_factory.mktemp("sb3-logs")))
+    yield
+    mp.undo()
+
+
 @pytest.fixture
 def free_start():
     """The helper :func:`_free_start` (a valid start pose around a home)."""
