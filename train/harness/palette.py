@@ -14,14 +14,14 @@ import zlib
 _HEX = {"black": "000000", "orange": "E69F00", "sky": "56B4E9", "green": "009E73",
         "blue": "0072B2", "vermillion": "D55E00", "purple": "CC79A7", "grey": "999999",
         "indigo": "332288", "teal": "44AA99", "olive": "999933", "wine": "882255",
-        "rose": "CC6677", "sand": "DDCC77"}
+        "rose": "CC6677", "sand": "DDCC77", "cyan": "88CCEE"}
 _FIXED = {"oracle": "black", "random": "grey", "snapshot": "orange", "warping": "sky",
           "distance": "blue", "bearing": "purple", "bearing-basic": "rose",
           "bearing-complementary": "wine", "bearing-longrange": "indigo",
           "selfsimilar": "olive", "multires": "teal",
           # the shipped learned policies (train/shipped/)
           "ppo_localhoming": "vermillion", "ppo_procedural_imitation": "green",
-          "ppo_procedural": "sand"}
+          "ppo_procedural": "sand", "ppo_procedural_arena": "cyan"}
 _SPARE = ("vermillion", "sand", "green")
 #: Marker colours of the maps (RGB 0-255), used by no method: home a dark navy ring, the
 #: start a light grey ring.
