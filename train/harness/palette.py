@@ -1,9 +1,10 @@
 """One colour per method in every plot, from colour-blind-safe palettes.
 
 Known methods have fixed colours (Okabe & Ito's eight, Paul Tol's muted set, then
-ColorBrewer's dark brown); any other name (a user's controller or policy) gets a colour from the rest, chosen by a
-stable hash of the name, so it is the same in every plot and run. Home and start markers
-use shapes and colours outside these (:data:`HOME_MARK`, :data:`START_MARK`).
+ColorBrewer's dark brown); any other name (a user's controller or policy) gets a colour
+from the rest, chosen by a stable hash of the name, so it is the same in every plot and
+run. Home and start markers use shapes and colours outside these (:data:`HOME_MARK`,
+:data:`START_MARK`).
 """
 
 from __future__ import annotations
