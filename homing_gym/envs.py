@@ -105,8 +105,10 @@ class LocalHomingEnv(HomingEnv):
 
     ## Arguments
 
-    ``gym.make("homing_gym/LocalHoming-v0", **kwargs)`` with: ``scene`` (``"arena"``,
-    ``"random_arena"`` or a :class:`~homing_gym.scenes.Scene`), ``render_mode``
+    ``gym.make("homing_gym/LocalHoming-v0", **kwargs)`` with: ``scene`` (``"arena"``;
+    any registered scene name, e.g. ``"random_arena"``, ``"random_rooms"``,
+    ``"random_nature"``; ``"mesh:PATH"`` for a mesh file; a
+    :class:`~homing_gym.scenes.Scene`), ``render_mode``
     (``None``, ``"rgb_array"``: top-down map beside current and goal panoramas;
     ``"human"``: PyBullet GUI), ``obs_keys``, ``panorama_shape`` = (48, 256),
     ``vfov_deg`` = 60, ``n_views`` = 6, ``renderer`` = ``"raycast"`` (exact ray
@@ -173,7 +175,7 @@ class RouteFollowingEnv(HomingEnv):
     Route following by successive local homing (Hong et al. 1991 §5). A route of target
     places was taught by taking a panoramic snapshot at each: by default 17 targets 1 ft
     (0.3048 m) apart along the centre line of the ``hallway`` scene, all facing along the
-    corridor. The robot starts 1 ft before the first target and must home to each target
+    corridor. The robot starts ``spacing`` (1 ft) before the first target and must home to each target
     in turn; the goal observation is the snapshot of the current target and switches to
     the next one when a target is reached. ``route`` gives any other route, curved or
     not, in any scene: the robot's start point followed by the targets.
@@ -201,7 +203,7 @@ class RouteFollowingEnv(HomingEnv):
 
     ## Starting state
 
-    1 ft before the first target, on the route line (with ``route``: its first point),
+    ``spacing`` (1 ft) before the first target, on the route line (with ``route``: its first point),
     perturbed uniformly by up to ``start_jitter`` = (0.05 m, 10 degrees) in x, y and
     heading, drawn from the seed.
     With ``lighting_change > 0`` the lighting of the run differs from the lighting of
@@ -383,8 +385,9 @@ class LandmarkNavigationEnv(HomingEnv):
 
     ``progress * (d_prev - d)``, ``d`` the distance (m) to the standing pose ``standoff``
     = 0.8 m in front of the goal landmark, ``+ success`` on success ``- collision`` per
-    step with contact ``- time`` per step; defaults 1.0, 10.0, 0.1, 0.01
-    (``RewardConfig``). Terms in ``info["rewards"]``.
+    step with contact ``- time`` per step ``- wrong_stop`` on a stop that is not a
+    success; defaults 1.0, 10.0, 0.1, 0.01, 0 (``RewardConfig``). Terms in
+    ``info["rewards"]``.
 
     ## Starting state
 
@@ -508,7 +511,8 @@ class WorkLocationsEnv(HomingEnv):
 
     ``progress * (d_prev - d)`` (``d`` the distance in metres to the target location)
     ``+ success`` once on success ``- collision`` per step with contact ``- time`` per
-    step; defaults 1.0, 10.0, 0.1, 0.01 (``RewardConfig``). Terms in ``info["rewards"]``.
+    step ``- wrong_stop`` on a stop outside the success radius; defaults 1.0, 10.0, 0.1,
+    0.01, 0 (``RewardConfig``). Terms in ``info["rewards"]``.
 
     ## Starting state
 

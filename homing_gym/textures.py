@@ -125,13 +125,19 @@ def generate_textures(size: int = 128, seed: int = 7) -> dict[str, np.ndarray]:
     return {k: np.clip(v, 0, 255).astype(np.uint8) for k, v in tex.items()}
 
 
-def main() -> None:
-    """Regenerate the shipped texture PNGs."""
-    TEXTURE_DIR.mkdir(parents=True, exist_ok=True)
+def main(argv: list[str] | None = None) -> int:
+    """Regenerate the shipped texture PNGs (``--out DIR`` writes them elsewhere)."""
+    from homing_gym.cli import command_parser
+    parser = command_parser("python -m homing_gym.textures", __doc__)
+    parser.add_argument("--out", type=Path, default=TEXTURE_DIR,
+                        help="folder to write the PNGs to (default: the package's own)")
+    out = parser.parse_args(argv).out
+    out.mkdir(parents=True, exist_ok=True)
     for name, img in generate_textures().items():
-        cv2.imwrite(str(TEXTURE_DIR / f"{name}.png"), img[..., ::-1])
-        print(f"wrote {TEXTURE_DIR / name}.png")
+        cv2.imwrite(str(out / f"{name}.png"), img[..., ::-1])
+        print(f"wrote {out / name}.png")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

@@ -26,6 +26,8 @@ COMMANDS = {
     "python -m homing_train.learning.rllib_ppo": "homing_train.learning.rllib_ppo",
     "python -m homing_train.learning.saturation": "homing_train.learning.saturation",
     "python -m homing_gym.envcard": "homing_gym.envcard",
+    "python -m homing_gym.textures": "homing_gym.textures",
+    "python -m homing_gym.scenes.mesh_example": "homing_gym.scenes.mesh_example",
 }
 
 
@@ -70,3 +72,16 @@ def test_import_makes_a_user_scene_visible_to_the_command_and_its_workers(tmp_pa
                                  text=True, env=env, timeout=300)
     assert with_import.returncode == 0, with_import.stderr[-2000:]
     assert "oracle on homing_gym/LocalHoming-v0: 2 episodes" in with_import.stdout
+
+
+def test_textures_are_written_where_asked_and_match_the_shipped_ones(tmp_path):
+    import cv2
+    import numpy as np
+
+    from homing_gym.textures import TEXTURE_DIR, main
+    assert main(["--out", str(tmp_path)]) == 0
+    written = sorted(path.name for path in tmp_path.iterdir())
+    assert written == sorted(path.name for path in TEXTURE_DIR.glob("*.png"))
+    for name in written:      # the pixels: the PNG encoder's bytes may vary by version
+        assert np.array_equal(cv2.imread(str(tmp_path / name)),
+                              cv2.imread(str(TEXTURE_DIR / name))), name

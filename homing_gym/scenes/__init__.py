@@ -72,7 +72,7 @@ register_scene("arena", SceneFactory(
     description="Yu & Kim arena: 2.4 m square, four red cylinders"))
 register_scene("corridors", SceneFactory(
     build=lambda rng: corridors_scene(),
-    description="8 x 6 m: four rooms off a corridor, 12 barcoded self-similar landmarks "
+    description="8 x 6 m: four rooms off a corridor, 14 barcoded self-similar landmarks "
                 "(Briggs et al. 2000)"))
 register_scene("hallway", SceneFactory(
     build=lambda rng: hallway_scene(),

@@ -11,8 +11,6 @@ own floor at z = 0. Each piece is a named node of the file (``north``, ``pillar`
 
 from __future__ import annotations
 
-import sys
-
 import trimesh
 
 #: The pillar: x, y, radius (metres).
@@ -61,7 +59,15 @@ def write_example_room(path) -> None:
         trimesh.util.concatenate(list(parts.values())).export(path)
 
 
+def main(argv: list[str] | None = None) -> int:
+    """Write the example room to the path given."""
+    from homing_gym.cli import command_parser
+    parser = command_parser("python -m homing_gym.scenes.mesh_example", __doc__)
+    parser.add_argument("out", help="the file to write: .glb/.gltf keeps the named parts, "
+                        "any other format trimesh writes (.obj, .ply, ...) one mesh")
+    write_example_room(parser.parse_args(argv).out)
+    return 0
+
+
 if __name__ == "__main__":
-    if len(sys.argv) != 2:
-        sys.exit("usage: python -m homing_gym.scenes.mesh_example OUT.glb")
-    write_example_room(sys.argv[1])
+    raise SystemExit(main())
