@@ -9,6 +9,7 @@ subclasses in :mod:`homing_gym.envs` that choose the task and carry the env card
 
 from __future__ import annotations
 
+import inspect
 import math
 from typing import Any
 
@@ -24,13 +25,14 @@ from homing_gym.paths import occupancy
 from homing_gym.perspective import PerspectiveConfig, render_perspective
 from homing_gym.robot import RobotConfig, odometry_for
 from homing_gym.scenes import scene_factory
-from homing_gym.scenes.base import Scene
+from homing_gym.scenes.base import Scene, clearance
 from homing_gym.simulator import Simulator, gui_unavailable
 from homing_gym.tasks.base import Task
 from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.episode import Episode
 from homing_gym.topdown import compose_frame, draw_topdown
-from homing_gym.validation import require_positive
+from homing_gym.validation import (is_real, require_number, require_positive,
+                                   require_sequence)
 
 ACTION_TYPES = ("continuous", "discrete")
 #: Where ``odometry`` starts: zero in the start pose's frame (path integration from where
@@ -63,6 +65,21 @@ def _check_room(scene: Scene, radius: float) -> None:
         raise ValueError(f"scene {scene.name!r} has no free space for the robot (a disc of "
                          f"radius {radius} m) within its bounds {scene.bounds!r} at the "
                          f"robot's height ({scene.height_band[0]}-{scene.height_band[1]} m)")
+
+
+def check_env_kwargs(env_class: type, kwargs: dict) -> None:
+    """``ValueError`` naming the keyword arguments in ``kwargs`` that neither
+    ``env_class.__init__`` nor :class:`HomingEnv` takes, and listing those they do
+    (instead of Python's ``TypeError``, which names one and lists none)."""
+    names = set()
+    for init in (env_class.__init__, HomingEnv.__init__):
+        names.update(name for name, param in inspect.signature(init).parameters.items()
+                     if param.kind in (param.POSITIONAL_OR_KEYWORD, param.KEYWORD_ONLY))
+    allowed = sorted(names - {"self", "task"})
+    unknown = sorted(set(kwargs) - set(allowed))
+    if unknown:
+        raise ValueError(f"{env_class.__name__} got unknown keyword arguments {unknown}; "
+                         f"allowed: {allowed}")
 
 
 class HomingEnv(gym.Env):
@@ -118,10 +135,11 @@ class HomingEnv(gym.Env):
                 f"1/{round(1 / MAX_TIME_STEP)}] s (PyBullet's contacts fail beyond)")
         require_positive("max_speed", max_speed, "m/s")
         require_positive("max_yaw_rate", max_yaw_rate, "rad/s")
-        if not (0 <= lighting_change <= 1):
-            raise ValueError(f"lighting_change must be in [0, 1] (0: off), got {lighting_change!r}")
-        if not (0 <= stop_threshold < 1):
-            raise ValueError(f"stop_threshold must be in [0, 1), got {stop_threshold!r}")
+        require_number("lighting_change", lighting_change, 0, 1, "(0: off)")
+        require_number("stop_threshold", stop_threshold, 0, 1, high_open=True)
+        require_number("vfov_deg", vfov_deg, 10, 120, "degrees")
+        panorama_shape = require_sequence("panorama_shape", panorama_shape, 2,
+                                          "(H, W) integers")
         if not (isinstance(episodes_per_world, (int, np.integer)) and episodes_per_world >= 1):
             raise ValueError(f"episodes_per_world must be an integer >= 1, got "
                              f"{episodes_per_world!r}")
@@ -129,9 +147,11 @@ class HomingEnv(gym.Env):
                                             "goal_step": goal_step_key(goal_step_length),
                                             **task.observation_keys()}
         allowed = tuple(table)
-        unknown = [k for k in obs_keys if k not in allowed]
-        if unknown or len(obs_keys) == 0 or len(set(obs_keys)) != len(obs_keys):
-            raise ValueError(f"bad obs_keys {tuple(obs_keys)!r}: give distinct keys from {allowed}")
+        keys = tuple(obs_keys) if isinstance(obs_keys, (list, tuple)) else ()
+        if (not keys or any(k not in allowed for k in keys)
+                or len(set(keys)) != len(keys)):
+            raise ValueError(f"bad obs_keys {obs_keys!r}: give a list or tuple of distinct "
+                             f"keys from {allowed}")
 
         self.render_mode = render_mode
         self.task = task
@@ -145,9 +165,7 @@ class HomingEnv(gym.Env):
         self._world_episodes_left = 0
         self.goal_step_length = float(goal_step_length)
         self._lighting: Lighting | None = None
-        if not (isinstance(camera_height, (int, float)) and 0.005 <= camera_height <= 5.0):
-            raise ValueError(f"camera_height must be in [0.005, 5] metres above the floor, "
-                             f"got {camera_height!r}")
+        require_number("camera_height", camera_height, 0.005, 5.0, "metres above the floor")
         if supersampling != CameraConfig.supersampling and renderer != "raycast":
             raise ValueError(f"supersampling needs renderer='raycast', got "
                              f"renderer={renderer!r}")
@@ -155,10 +173,10 @@ class HomingEnv(gym.Env):
             if renderer != "raycast":
                 raise ValueError(f"sky_color needs renderer='raycast' (the {renderer!r} "
                                  f"renderer's background is fixed), got renderer={renderer!r}")
-            if len(sky_color) != 3 or not all(
-                    isinstance(c, (int, float)) and 0 <= c <= 1 for c in sky_color):
-                raise ValueError(f"sky_color must be three RGB values in [0, 1], "
-                                 f"got {sky_color!r}")
+            what = "three RGB values in [0, 1]"
+            for c in require_sequence("sky_color", sky_color, 3, what):
+                if not (is_real(c) and 0 <= c <= 1):
+                    raise ValueError(f"sky_color must be {what}, got {sky_color!r}")
         if shadows not in (True, False):
             raise ValueError(f"shadows must be True or False, got {shadows!r}")
         if shadows and renderer != "raycast":
@@ -363,18 +381,32 @@ class HomingEnv(gym.Env):
 
     def _episode_with_options(self, episode: Episode, options: dict) -> Episode:
         """Apply ``reset(options={"home": pose, "start": pose})`` overrides (poses
-        ``(x, y, yaw)`` in metres and radians, inside the scene bounds)."""
+        ``(x, y, yaw)`` in metres and radians, inside the scene bounds; the start with
+        room for the robot's body, the home off walls and objects)."""
+        if not isinstance(options, dict):
+            raise ValueError(f"reset options must be a dict with keys 'home' and/or 'start', "
+                             f"got {options!r}")
         unknown = sorted(set(options) - {"home", "start"})
         if unknown:
             raise ValueError(f"unknown reset options {unknown}; allowed: ['home', 'start']")
         poses = {"home": episode.home, "start": episode.start}
         (xmin, ymin), (xmax, ymax) = self.scene.bounds
         for key, value in options.items():
-            pose = np.asarray(value, dtype=np.float64)
+            try:
+                pose = np.asarray(value, dtype=np.float64)
+            except (TypeError, ValueError):
+                pose = np.full(1, np.nan)             # refused just below, with its name
             if pose.shape != (3,) or not np.all(np.isfinite(pose)) or not (
                     xmin <= pose[0] <= xmax and ymin <= pose[1] <= ymax):
                 raise ValueError(f"reset option {key}={value!r} must be a finite pose "
                                  f"(x, y, yaw) with x in [{xmin}, {xmax}], y in [{ymin}, {ymax}]")
+            # the robot stands at the start; the home only needs to be in free space
+            need = self.robot_config.body_radius if key == "start" else 0.0
+            free = clearance(self.scene, (pose[0], pose[1]))
+            if free <= need:
+                raise ValueError(f"reset option {key}={value!r} lies in a wall or object"
+                                 + (f" for the robot (radius {need} m)" if need else "")
+                                 + f": {max(free, 0.0):.3f} m free there")
             poses[key] = pose
         return Episode(home=poses["home"], start=poses["start"], waypoints=episode.waypoints)
 

@@ -6,7 +6,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from homing_gym.env import HomingEnv
+from homing_gym.env import HomingEnv, check_env_kwargs
 from homing_gym.geometry import FOOT
 from homing_gym.panorama import CameraConfig
 from homing_gym.scenes import SceneFactory, scene_factory
@@ -18,6 +18,7 @@ from homing_gym.tasks import (LocalHomingTask, LongRangeHomingTask, RewardConfig
 from homing_gym.tasks.landmark_navigation import LandmarkNavigationTask
 from homing_gym.tasks.work_locations import MAX_POINTS, TAUGHT_KEYS, WorkLocationsTask
 from homing_gym.teaching import PLACE_SPACING
+from homing_gym.validation import require_number, require_sequence
 
 
 class LocalHomingEnv(HomingEnv):
@@ -148,6 +149,7 @@ class LocalHomingEnv(HomingEnv):
                  start_distance: tuple[float, float] = (0.3, 1.5),
                  success_radius: float = 0.15, success_on: str = "reach",
                  reward: RewardConfig = RewardConfig(), **kwargs):
+        check_env_kwargs(type(self), kwargs)
         task = LocalHomingTask(start_distance=start_distance, success_radius=success_radius,
                                success_on=success_on, reward=reward)
         super().__init__(task, scene, **kwargs)
@@ -249,6 +251,7 @@ class RouteFollowingEnv(HomingEnv):
                  start_jitter: tuple[float, float] = (0.05, 0.1745),
                  success_radius: float = 0.1, success_on: str = "reach",
                  reward: RewardConfig = RewardConfig(), **kwargs):
+        check_env_kwargs(type(self), kwargs)
         task = RouteFollowingTask(n_targets=n_targets, spacing=spacing, route=route,
                                   start_jitter=start_jitter, success_radius=success_radius,
                                   success_on=success_on, reward=reward)
@@ -340,6 +343,7 @@ class LongRangeHomingEnv(HomingEnv):
                  reward: RewardConfig = RewardConfig(),
                  obs_keys: tuple[str, ...] | list[str] = ("panorama", "goal", "phase"),
                  **kwargs):
+        check_env_kwargs(type(self), kwargs)
         task = LongRangeHomingTask(route_length=route_length, outbound_speed=outbound_speed,
                                    outbound_yaw_rate=outbound_yaw_rate,
                                    success_radius=success_radius, success_on=success_on,
@@ -433,13 +437,15 @@ class LandmarkNavigationEnv(HomingEnv):
                  remove_landmarks: float = 0.0, occlude_landmarks: float = 0.0,
                  view_size: tuple[int, int] = (320, 240), view_hfov_deg: float = 60.0,
                  obs_keys: tuple[str, ...] | list[str] = ("panorama", "goal_id"), **kwargs):
+        check_env_kwargs(type(self), kwargs)
         for name, value in (("remove_landmarks", remove_landmarks),
                             ("occlude_landmarks", occlude_landmarks)):
-            if not (isinstance(value, (int, float)) and 0 <= value <= 1):
-                raise ValueError(f"{name} must be a probability in [0, 1], got {value!r}")
+            require_number(name, value, 0, 1, "(a probability)")
         task = LandmarkNavigationTask(max_distance=max_distance, max_angle_deg=max_angle_deg,
                                       standoff=standoff, success_on=success_on, reward=reward,
-                                      view_size=tuple(view_size), view_hfov_deg=view_hfov_deg)
+                                      view_size=require_sequence("view_size", view_size, 2,
+                                                                 "(width, height) integers"),
+                                      view_hfov_deg=view_hfov_deg)
         factory = scene_factory(scene)
         if remove_landmarks > 0 or occlude_landmarks > 0:
             base = factory
@@ -570,11 +576,11 @@ class WorkLocationsEnv(HomingEnv):
                  panorama_shape: tuple[int, int] = (64, 512),
                  obs_keys: tuple[str, ...] | list[str] = ("panorama", *TAUGHT_KEYS),
                  **kwargs):
-        if not (isinstance(daily_changes, (int, float)) and 0 <= daily_changes <= 1):
-            raise ValueError(f"daily_changes must be in [0, 1] (0: the house as taught), "
-                             f"got {daily_changes!r}")
-        CameraConfig(panorama_shape=tuple(panorama_shape))   # checks the shape first
-        task = WorkLocationsTask(tuple(panorama_shape), start_location, goal_location,
+        check_env_kwargs(type(self), kwargs)
+        require_number("daily_changes", daily_changes, 0, 1, "(0: the house as taught)")
+        panorama_shape = require_sequence("panorama_shape", panorama_shape, 2, "(H, W) integers")
+        CameraConfig(panorama_shape=panorama_shape)   # checks the shape first
+        task = WorkLocationsTask(panorama_shape, start_location, goal_location,
                                  start_jitter=start_jitter, teach_levels=teach_levels,
                                  spacing=place_spacing, template_size=template_size,
                                  max_points=max_points, success_radius=success_radius,

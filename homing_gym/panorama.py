@@ -39,6 +39,7 @@ import numpy as np
 import pybullet as p
 from pybullet_utils.bullet_client import BulletClient
 
+from homing_gym.validation import require_number
 from homing_gym.vision import horizon_line
 
 RENDERERS = ("tiny", "egl", "raycast")
@@ -98,14 +99,12 @@ class CameraConfig:
                              f"{self.vfov!r} rad = {math.degrees(self.vfov):.1f} deg")
         if self.n_views not in (3, 4, 6, 8):
             raise ValueError(f"n_views must be one of (3, 4, 6, 8), got {self.n_views!r}")
-        if not (16 <= self.omni_size <= 2048):
-            raise ValueError(f"omni_size must be in [16, 2048] pixels, got {self.omni_size!r}")
+        require_number("omni_size", self.omni_size, 16, 2048, "pixels", integer=True)
         if not (1 <= self.signature_rows <= shape[0] - 2):
             raise ValueError(f"signature_rows must be in [1, H - 2] = [1, {shape[0] - 2}], "
                              f"got {self.signature_rows!r}")
-        if self.supersampling not in (1, 2, 3, 4):
-            raise ValueError(f"supersampling must be 1, 2, 3 or 4 (rays per pixel side), "
-                             f"got {self.supersampling!r}")
+        require_number("supersampling", self.supersampling, 1, 4, "rays per pixel side",
+                       integer=True)
         if self.renderer not in RENDERERS:
             raise ValueError(f"unknown renderer {self.renderer!r}; allowed: {RENDERERS}")
         if not (0 < self.near < self.far):

@@ -21,6 +21,8 @@ from scipy.sparse.csgraph import dijkstra
 from homing_gym.scenes.base import Scene, clearances
 
 # the four forward steps (dx >= 0) of the 8-connected grid and their lengths (cells)
+#: Floor points whose clearances are computed at once (bounds the memory of big worlds).
+CHUNK = 1 << 16
 _STEPS = ((1, 0, 1.0), (0, 1, 1.0), (1, 1, math.sqrt(2.0)), (1, -1, math.sqrt(2.0)))
 
 
@@ -37,7 +39,9 @@ def occupancy(scene: Scene, radius: float, resolution: float) -> tuple[np.ndarra
     ny = int(math.floor((ymax - ymin) / resolution)) + 1
     gx, gy = np.meshgrid(xmin + np.arange(nx) * resolution, ymin + np.arange(ny) * resolution,
                          indexing="ij")
-    free = clearances(scene, np.stack([gx.ravel(), gy.ravel()], axis=1)) >= radius
+    points = np.stack([gx.ravel(), gy.ravel()], axis=1)
+    free = np.concatenate([clearances(scene, points[i:i + CHUNK]) >= radius
+                           for i in range(0, len(points), CHUNK)])
     return free.reshape(nx, ny), (xmin, ymin)
 
 

@@ -35,6 +35,11 @@ URDF_PATH = str(resources.files("homing_gym") / "assets" / "robot.urdf")
 DRIVES = ("differential", "synchro")
 
 
+#: PyBullet's default top speed of a joint (rad/s, ``maxJointVelocity``): wheel motors
+#: asked for more reach only this.
+MAX_WHEEL_SPEED = 100.0
+
+
 @dataclass(frozen=True)
 class RobotConfig:
     """Physical constants of the robot (metres, seconds, radians).
@@ -59,6 +64,14 @@ class RobotConfig:
     def __post_init__(self) -> None:
         if self.drive not in DRIVES:
             raise ValueError(f"unknown drive {self.drive!r}; allowed: {DRIVES}")
+        if self.drive == "differential" and self.max_wheel_speed > MAX_WHEEL_SPEED:
+            raise ValueError(
+                f"max_speed {self.max_speed!r} m/s with max_yaw_rate {self.max_yaw_rate!r} "
+                f"rad/s asks the wheels for {self.max_wheel_speed:.0f} rad/s; at most "
+                f"{MAX_WHEEL_SPEED:.0f} rad/s (PyBullet's joint speed limit; a faster command "
+                f"would be cut short): max_speed + max_yaw_rate * "
+                f"{self.wheel_separation / 2:g} <= "
+                f"{MAX_WHEEL_SPEED * self.wheel_radius:g} m/s")
 
     @property
     def max_wheel_speed(self) -> float:

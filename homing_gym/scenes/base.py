@@ -118,6 +118,9 @@ class Wall:
 #: Heights (metres above the floor) in which mesh parts block the robot: above floor-level
 #: detail, up to just over the camera (:mod:`homing_gym.scenes.footprint`).
 HEIGHT_BAND = (0.02, 0.35)
+#: Largest side (metres) of a scene's ``bounds``: the start/home sampling and the oracle
+#: grid the free floor in 2-5 cm cells (100 m: 4 million cells at 5 cm).
+MAX_SIDE = 100.0
 
 
 @dataclass(frozen=True)
@@ -150,6 +153,11 @@ class Scene:
             raise ValueError(f"scene {self.name!r}: bounds must be finite, got {self.bounds!r}")
         if not (xmax > xmin and ymax > ymin):
             raise ValueError(f"scene {self.name!r}: empty bounds {self.bounds!r}")
+        if max(xmax - xmin, ymax - ymin) > MAX_SIDE:
+            raise ValueError(f"scene {self.name!r}: bounds {self.bounds!r} span more than "
+                             f"{MAX_SIDE:g} m a side (the free floor is gridded in 2-5 cm "
+                             f"cells); give smaller bounds, e.g. mesh:PATH?bounds=xmin,ymin,"
+                             f"xmax,ymax")
         if not all(isinstance(m, MeshPart) for m in self.meshes):
             raise ValueError(f"scene {self.name!r}: meshes must be MeshPart objects")
         low, high = self.height_band

@@ -8,6 +8,7 @@ add observation keys through :meth:`Task.observation_keys`.
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 from typing import ClassVar
 
@@ -59,6 +60,19 @@ class Task(ABC):
     def extra_info(self, ctx: TaskContext) -> dict:
         """Task-specific entries added to ``info`` at reset and every step."""
         return {}
+
+
+def check_start_jitter(scene: Scene, point, jitter: float, margin: float, what: str) -> None:
+    """``ValueError`` unless every start within ``jitter`` metres (in x and in y) of the
+    floor ``point`` keeps ``margin`` metres of clearance: the clearance at ``point`` less
+    the square's half diagonal. ``what`` names the point in the message."""
+    free = clearance(scene, (point[0], point[1]))
+    if free - jitter * math.sqrt(2) < margin:
+        fits = max(math.floor((free - margin) / math.sqrt(2) * 1000) / 1000, 0.0)   # mm, down
+        raise ValueError(f"start_jitter {jitter!r} m around {what} ({point[0]:.2f}, "
+                         f"{point[1]:.2f}) of scene {scene.name!r} could start the robot "
+                         f"within {margin} m of a wall or object ({free:.2f} m free there); "
+                         f"at most {fits:.3f} m fits")
 
 
 def sample_free_pose(scene: Scene, rng: np.random.Generator, margin: float,

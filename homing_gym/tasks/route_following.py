@@ -13,7 +13,7 @@ import numpy as np
 from homing_gym.geometry import FOOT, wrap_angle
 from homing_gym.scenes.base import Scene, clearance
 from homing_gym.tasks.context import TaskContext
-from homing_gym.tasks.base import Episode
+from homing_gym.tasks.base import Episode, check_start_jitter
 from homing_gym.tasks.goal_reaching import GoalReachingTask, RewardConfig
 from homing_gym.validation import require_positive
 
@@ -110,15 +110,18 @@ class RouteFollowingTask(GoalReachingTask):
         if self.route is not None:
             for k, pose in enumerate(self.route):
                 self._check_route_point(scene, k, pose)
-            return
-        if "route_origin" not in scene.metadata:
+        elif "route_origin" not in scene.metadata:
             raise ValueError(f"scene {scene.name!r} defines no route (metadata['route_origin']); "
                              f"use a scene with one, e.g. 'hallway', or give route=[...]")
-        for pose in self._route(scene):
-            if clearance(scene, (pose[0], pose[1])) < self.clearance_margin:
-                raise ValueError(
-                    f"{self.n_targets} targets {self.spacing} m apart do not fit along the "
-                    f"route of scene {scene.name!r}: ({pose[0]:.2f}, {pose[1]:.2f}) is blocked")
+        else:
+            for pose in self._route(scene):
+                if clearance(scene, (pose[0], pose[1])) < self.clearance_margin:
+                    raise ValueError(
+                        f"{self.n_targets} targets {self.spacing} m apart do not fit along "
+                        f"the route of scene {scene.name!r}: ({pose[0]:.2f}, {pose[1]:.2f}) "
+                        f"is blocked")
+        check_start_jitter(scene, self._route(scene)[0], self.start_jitter[0],
+                           self.clearance_margin, "the route's start")
 
     def _check_route_point(self, scene: Scene, k: int, pose: np.ndarray) -> None:
         """``ValueError`` if point ``k`` of the given route lies outside ``scene.bounds``

@@ -24,7 +24,7 @@ from homing_gym.geometry import wrap_angle
 from homing_gym.observations import ObservationKey, constant_key
 from homing_gym.scenes.base import Scene
 from homing_gym.tasks.context import TaskContext
-from homing_gym.tasks.base import Episode
+from homing_gym.tasks.base import Episode, check_start_jitter
 from homing_gym.tasks.goal_reaching import GoalReachingTask, RewardConfig
 from homing_gym.teaching import PLACE_SPACING, FeatureMap, teach_path, teach_work_location
 from homing_gym.vision import low_resolution_shape
@@ -33,6 +33,8 @@ from homing_gym.vision import low_resolution_shape
 #: Most taught places on one path (15 m at 0.47 m) and characteristic points per map
 #: (the paper's map of Fig. 2 holds 10).
 MAX_PLACES, MAX_POINTS = 32, 10
+#: Clearance (m) every start must keep: the robot's radius (0.16 m) and 2 cm.
+START_CLEARANCE = 0.18
 #: Observation keys this task adds.
 TAUGHT_KEYS = ("path_panoramas", "path_count", "map_panorama", "map_templates",
                "map_template_xy", "map_points", "map_count", "map_pose")
@@ -110,6 +112,10 @@ class WorkLocationsTask(GoalReachingTask):
         if not self._candidate_paths(scene):
             raise ValueError(f"scene {scene.name!r} has no path from {self.start_location!r} "
                              f"to {self.goal_location!r}")
+        for start, _ in self._candidate_paths(scene):
+            check_start_jitter(scene, scene.metadata["work_locations"][start],
+                               self.start_jitter[0], START_CLEARANCE,
+                               f"the work location {start!r}")
         for key, points in scene.metadata["paths"].items():
             length = float(np.sum(np.linalg.norm(np.diff(points, axis=0), axis=1)))
             if length / self.spacing + len(points) > MAX_PLACES:

@@ -61,7 +61,7 @@ def test_a_task_runs_through_its_context_only():
 
 def test_info_carries_home_and_start_as_reset_options_set_them():
     env = gym.make("homing_gym/LocalHoming-v0", panorama_shape=(16, 64))
-    home, start = [0.2, -0.3, 1.0], [-0.4, 0.5, -2.0]
+    home, start = [0.2, -0.3, 1.0], [-0.7, 0.3, -2.0]     # start clear of the cylinders
     _, info = env.reset(seed=3, options={"home": home, "start": start})
     np.testing.assert_allclose(info["home_pose"], home, atol=1e-6)
     np.testing.assert_allclose(info["start_pose"], start, atol=1e-4)

@@ -35,14 +35,79 @@ ENV = "homing_gym/LocalHoming-v0"
     ({"reward": {"progres": 10.0}}, ["progres", "progress", "collision"]),
     ({"reward": {"success": math.inf}}, ["success", "inf"]),
     ({"reward": 10.0}, ["reward", "10.0"]),
+    ({"panorama_shape": 48}, ["panorama_shape", "(H, W)", "48"]),
+    ({"sky_color": 5}, ["sky_color", "three RGB", "5"]),
+    ({"obs_keys": None}, ["obs_keys", "None", "panorama"]),
+    ({"obs_keys": "panorama"}, ["obs_keys", "'panorama'", "list or tuple"]),
+    ({"omni_size": 100.5, "obs_keys": ("omni", "goal")}, ["omni_size", "integer", "100.5"]),
+    ({"supersampling": True}, ["supersampling", "integer", "True"]),
+    ({"vfov_deg": "60"}, ["vfov_deg", "'60'"]),
+    ({"stop_threshold": "a"}, ["stop_threshold", "[0, 1)", "'a'"]),
+    ({"lighting_change": None}, ["lighting_change", "None"]),
+    ({"camera_height": True}, ["camera_height", "True"]),
+    ({"max_speed": 1e9}, ["max_speed", "100 rad/s", "3.5 m/s"]),
+    ({"max_yaw_rate": 1e9}, ["max_yaw_rate", "100 rad/s"]),
+    ({"bogus": 1, "other": 2}, ["['bogus', 'other']", "camera_height", "start_distance"]),
+    ({"scene": "mesh:MESH?bounds=0,0,1000,1000"}, ["100 m a side", "bounds"]),
 ])
-def test_bad_kwargs(kwargs, words):
+def test_bad_kwargs(kwargs, words, tmp_path):
+    if str(kwargs.get("scene", "")).startswith("mesh:MESH"):
+        from homing_gym.scenes.mesh_example import write_example_room
+        write_example_room(tmp_path / "room.glb")
+        kwargs = {**kwargs, "scene": kwargs["scene"].replace("MESH", str(tmp_path / "room.glb"))}
     with pytest.raises(ValueError) as err:
         env = gym.make(ENV, **kwargs)
         env.reset(seed=0)
         env.close()
     for word in words:
         assert word in str(err.value)
+
+
+def test_numpy_numbers_are_numbers():
+    env = gym.make(ENV, camera_height=np.float32(0.2), lighting_change=np.float64(0.5),
+                   panorama_shape=np.array([16, 64]))
+    env.reset(seed=0)
+    assert env.observation_space["panorama"].shape == (16, 64, 3)
+    env.close()
+
+
+@pytest.mark.parametrize("options, words", [
+    ({"start": (1.19, 1.19, 0.0)}, ["start", "wall or object", "0.16 m", "0.010 m free"]),
+    ({"start": (-0.4, 0.5, 0.0)}, ["start", "wall or object"]),      # inside a cylinder
+    ({"home": (-0.35, 0.55, 0.0)}, ["home", "wall or object", "0.000 m free"]),
+    ({"home": "abc"}, ["home", "'abc'", "finite pose"]),
+    ("home", ["reset options", "dict", "'home'"]),
+])
+def test_reset_options_must_leave_the_robot_in_free_space(make_env, options, words):
+    env = make_env(panorama_shape=(16, 64))
+    with pytest.raises(ValueError) as err:
+        env.reset(seed=0, options=options)
+    for word in words:
+        assert word in str(err.value)
+    # a home near a cylinder (the robot can come within 0.15 m of it) stays allowed
+    _, info = env.reset(seed=0, options={"home": (0.2, -0.3, 1.0)})
+    assert np.allclose(info["home_pose"], (0.2, -0.3, 1.0))
+
+
+@pytest.mark.parametrize("env_id, jitter, words", [
+    ("homing_gym/RouteFollowing-v0", 100.0, ["start_jitter 100.0 m", "route's start",
+                                            "hallway", "at most 0.473 m fits"]),   # (0.85 - 0.18) / sqrt 2
+    ("homing_gym/WorkLocations-v0", 0.3, ["start_jitter 0.3 m", "'bedroom'", "house",
+                                         "at most 0.190 m fits"]),   # (0.45 - 0.18) / sqrt 2
+])
+def test_start_jitter_must_fit_the_room_around_the_start(env_id, jitter, words):
+    with pytest.raises(ValueError) as err:
+        gym.make(env_id, start_jitter=(jitter, 0.0))
+    for word in words:
+        assert word in str(err.value)
+    # what the message says fits does fit: every start stays clear of walls and objects
+    fits = float(str(err.value).split("at most ")[1].split(" m")[0])
+    env = gym.make(env_id, start_jitter=(fits, 0.0), panorama_shape=(16, 128))
+    from homing_gym.scenes.base import clearance
+    for seed in range(5):
+        _, info = env.reset(seed=seed)
+        assert clearance(env.unwrapped.scene, info["start_pose"][:2]) >= 0.16
+    env.close()
 
 
 @pytest.mark.parametrize("action", [np.array([np.nan, 0.0], np.float32),
