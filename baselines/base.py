@@ -21,12 +21,14 @@ controllers that declare ``needs_env = True`` (oracles, named as such), through
 from __future__ import annotations
 
 import dataclasses
+import math
 from abc import ABC, abstractmethod
 from typing import Any, ClassVar
 
 import numpy as np
 
 from homing_baselines.motion import MOTION_STYLES, MotionHelper, MotionSpec, Move
+from homing_gym.validation import is_real
 
 
 @dataclasses.dataclass
@@ -67,6 +69,7 @@ class Controller(ABC):
         if self.motion not in MOTION_STYLES:
             raise ValueError(f"{type(self).__name__}: unknown motion {self.motion!r}; "
                              f"allowed: {MOTION_STYLES}")
+        self._check_parameter_kinds()
         self.validate()
         self._helper = MotionHelper(MotionSpec(), self.motion)
         self._queue: list = []
@@ -74,6 +77,25 @@ class Controller(ABC):
         self.last_direction: float | None = None
         self.last_home_direction: float | None = None
         self.last_move: Move | None = None
+
+    def _check_parameter_kinds(self) -> None:
+        """``ValueError`` for a parameter not of its default's kind: ``True``/``False``
+        where the default is a bool, text where it is a str, a finite number where it is
+        a number (infinite only where the default is). Ranges are :meth:`validate`'s."""
+        for f in dataclasses.fields(self):
+            default, value = f.default, getattr(self, f.name)
+            if isinstance(default, bool):
+                ok, kind = isinstance(value, (bool, np.bool_)), "True or False"
+            elif isinstance(default, str):
+                ok, kind = isinstance(value, str), "text"
+            elif isinstance(default, (int, float)):
+                ok = is_real(value) or (not math.isfinite(default) and value == default)
+                kind = "a finite number"
+            else:
+                continue
+            if not ok:
+                raise ValueError(f"{type(self).__name__}: parameter {f.name} must be {kind}, "
+                                 f"got {value!r}")
 
     # -- to override -----------------------------------------------------------------------
     def validate(self) -> None:

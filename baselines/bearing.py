@@ -138,7 +138,9 @@ class BearingController(BearingLawController):
         super().validate()
         if self.law not in LAWS:
             raise ValueError(f"unknown law {self.law!r}; allowed: {LAWS}")
-        unknown = [c for c in self.colors if c not in PALETTE]
+        unknown = ([self.colors] if isinstance(self.colors, str)
+                   or not isinstance(self.colors, (list, tuple))
+                   else [c for c in self.colors if c not in PALETTE])
         if unknown or len(set(self.colors)) < 3 or len(set(self.colors)) != len(self.colors):
             raise ValueError(f"colors must be at least 3 distinct names from "
                              f"{sorted(PALETTE)}, got {self.colors!r}")

@@ -73,6 +73,11 @@ class MultiResController(Controller):
     def validate(self) -> None:
         if not (5 <= self.front_fov_deg <= 180):
             raise ValueError(f"front_fov_deg must be in [5, 180] degrees, got {self.front_fov_deg!r}")
+        if not (10 <= self.vfov_deg <= 120):      # the env's camera takes the same range
+            raise ValueError(f"vfov_deg must be in [10, 120] degrees, got {self.vfov_deg!r}")
+        if not (0 < self.heading_tolerance_deg < 180):
+            raise ValueError(f"heading_tolerance_deg must be in (0, 180) degrees, got "
+                             f"{self.heading_tolerance_deg!r}")
         for name in ("step_length", "arrival_step", "stop_tolerance", "camera_height"):
             value = getattr(self, name)
             require_positive(name, value, "metres")

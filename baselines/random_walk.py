@@ -24,6 +24,8 @@ class RandomController(Controller):
         if not (math.isfinite(self.step_length) and self.step_length > 0):
             raise ValueError(f"random: step_length must be positive metres, "
                              f"got {self.step_length!r}")
+        if not (isinstance(self.seed, (int, np.integer)) and self.seed >= 0):
+            raise ValueError(f"random: seed must be an integer >= 0, got {self.seed!r}")
 
     def on_reset(self) -> None:
         episode = [] if self._seed is None else [int(self._seed)]

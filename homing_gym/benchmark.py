@@ -248,6 +248,11 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.steps < 10 or args.workers < 1 or args.resets < 0:
         parser.error("need --steps >= 10, --workers >= 1 and --resets >= 0")
+    if args.json:                       # before the minutes of measuring, not after them
+        try:
+            open(args.json, "w").close()
+        except OSError as err:
+            parser.error(f"--json {args.json!r}: cannot write it ({err.strerror})")
     results = [run_config(name, kwargs, args.steps, args.workers)
                for name, kwargs in configs(args.renderers, args.shapes, args.worlds).items()]
     print(format_table(results))

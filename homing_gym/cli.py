@@ -36,6 +36,17 @@ class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter,
         return super()._get_help_string(action)
 
 
+def seed_value(text: str) -> int:
+    """``--seed``'s type: an integer >= 0 (what ``reset(seed=...)`` takes)."""
+    try:
+        seed = int(text)
+    except ValueError:
+        seed = -1
+    if seed < 0:
+        raise argparse.ArgumentTypeError(f"a seed is an integer >= 0, got {text!r}")
+    return seed
+
+
 def plain(text: str) -> str:
     """reStructuredText markup of a docstring as plain text (````x```` and ``:role:`x```
     become ``x``; ``~a.b`` becomes ``b``)."""

@@ -83,6 +83,24 @@ def test_bad_moves_and_styles_raise():
         homing_baselines.make("random", motion="teleport")
 
 
+@pytest.mark.parametrize("name, params, words", [
+    ("warping", {"smooth_deg": "2"}, ["smooth_deg", "finite number", "'2'"]),
+    ("warping", {"smooth_deg": math.inf}, ["smooth_deg", "inf"]),
+    ("snapshot", {"k_high": math.nan}, ["k_high", "nan"]),
+    ("oracle", {"align_heading": "yes"}, ["align_heading", "True or False", "'yes'"]),
+    ("oracle", {"step_length": True}, ["step_length", "True"]),
+    ("random", {"seed": -1}, ["seed", "integer >= 0", "-1"]),
+    ("multires", {"vfov_deg": math.nan}, ["vfov_deg", "nan"]),
+    ("multires", {"heading_tolerance_deg": -5.0}, ["heading_tolerance_deg", "-5.0"]),
+    ("bearing", {"colors": 5}, ["colors", "5"]),
+])
+def test_parameters_of_the_wrong_kind_or_range_are_refused(name, params, words):
+    with pytest.raises(ValueError) as err:
+        homing_baselines.make(name, **params)
+    for word in words:
+        assert word in str(err.value)
+
+
 def test_random_controller_is_reproducible_per_episode_seed():
     def directions(seed):
         c = homing_baselines.make("random")

@@ -196,7 +196,7 @@ def test_run_episodes_takes_a_home_pose_per_task():
     from homing_train.harness.evaluate import run_episodes
     from homing_train.harness.policies import policy_spec
 
-    home, start = (0.3, -0.2, 1.0), (-0.4, 0.5, 0.0)
+    home, start = (0.3, -0.2, 1.0), (-0.7, 0.3, 0.0)     # start clear of the cylinders
     recs = run_episodes(policy_spec("oracle"), "homing_gym/LocalHoming-v0",
                         {"max_episode_steps": 3}, [(5, start, home), (6, None, home), (7,)],
                         workers=1, progress=False)

@@ -58,7 +58,7 @@ from tqdm import tqdm  # noqa: E402
 from homing_baselines.bearing_laws import LAWS  # noqa: E402
 from homing_baselines.bearing_sim import (ReachabilityMap, SimConfig, circumcircle,  # noqa: E402
                                    reachability_map, region)
-from homing_gym.cli import command_parser  # noqa: E402
+from homing_gym.cli import command_parser, seed_value  # noqa: E402
 from homing_train.figures import MEASURED_WITH  # noqa: E402
 from homing_train.harness.policies import parse_params  # noqa: E402
 
@@ -595,7 +595,7 @@ def main(argv: list[str] | None = None) -> int:
     f11.add_argument("--out", default="docs/bearing", help="output folder")
     f11.add_argument("--runs", type=int, default=30, help="runs per marked position")
     f11.add_argument("--max-steps", type=int, default=800)
-    f11.add_argument("--seed", type=int, default=11,
+    f11.add_argument("--seed", type=seed_value, default=11,
                      help="seed of the starts (11: the documented table; others: fresh starts)")
     f11.add_argument("--no-progress", action="store_true")
     pr = sub.add_parser("pixel-reachability",
@@ -609,7 +609,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="the unified law in the lab, homes anywhere, with 2-D reachability")
     la.add_argument("--out", default="docs/bearing", help="output folder")
     la.add_argument("--episodes", type=int, default=40)
-    la.add_argument("--seed", type=int, default=0, help="seed of the first episode")
+    la.add_argument("--seed", type=seed_value, default=0, help="seed of the first episode")
     la.add_argument("--max-steps", type=int, default=800)
     la.add_argument("--param", action="append", metavar="KEY=VALUE",
                     help="a parameter of the bearing controller (repeatable)")
@@ -617,7 +617,7 @@ def main(argv: list[str] | None = None) -> int:
     lr = sub.add_parser("longrange", help="bearing-longrange on LongRangeHoming-v0")
     lr.add_argument("--out", default="docs/bearing", help="output folder")
     lr.add_argument("--episodes", type=int, default=10)
-    lr.add_argument("--seed", type=int, default=0, help="seed of the first episode")
+    lr.add_argument("--seed", type=seed_value, default=0, help="seed of the first episode")
     lr.add_argument("--route-length", type=float, default=8.0, help="outbound route (m)")
     lr.add_argument("--workers", type=int, default=1, help="processes")
     lr.add_argument("--no-progress", action="store_true")

@@ -31,7 +31,7 @@ import homing_baselines
 import homing_gym
 from homing_baselines.multires import LOCALISE
 from homing_baselines.multires_localise import localise
-from homing_gym.cli import command_parser
+from homing_gym.cli import command_parser, seed_value
 from homing_gym.scenes.base import clearance
 from homing_gym.teaching import FeatureMap
 from homing_train.figures import MEASURED_WITH
@@ -172,7 +172,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="localisation: this many seeded random poses per work location "
                              "(uniform in the 0.5 m disc, any heading) instead of the grid")
     parser.add_argument("--episodes", type=int, default=30)
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=seed_value, default=0)
     parser.add_argument("--daily-changes", type=float, default=0.0)
     args = parser.parse_args(argv)
     if not (args.spacing > 0 and args.headings >= 1 and args.random_poses >= 0):

@@ -15,7 +15,7 @@ import imageio.v2 as imageio
 import numpy as np
 
 import homing_gym  # noqa: F401  (registers the env ids)
-from homing_gym.cli import command_parser
+from homing_gym.cli import command_parser, seed_value
 from homing_gym.scenes import available_scenes
 
 
@@ -37,7 +37,7 @@ def side_by_side(scene: str, seed: int, shape: tuple[int, int]) -> tuple[np.ndar
 def main(argv: list[str] | None = None) -> int:
     parser = command_parser("python -m homing_train.figures.renderers", __doc__)
     parser.add_argument("--out", default="docs/images/raycast", help="output folder")
-    parser.add_argument("--seed", type=int, default=2, help="episode whose start is shown")
+    parser.add_argument("--seed", type=seed_value, default=2, help="episode whose start is shown")
     args = parser.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)

@@ -206,6 +206,10 @@ def compare(paths: Sequence[str], out: str, trajectories: int = 3) -> dict[str, 
     the written file paths by kind."""
     if not paths:
         raise ValueError("give at least one result JSON")
+    if trajectories < 0:
+        raise ValueError(f"trajectories must be >= 0 (0: no map), got {trajectories}")
+    if os.path.exists(out) and not os.path.isdir(out):
+        raise ValueError(f"--out {out!r} is a file; give a folder")
     results = [EvalResult.load(p) for p in paths]
     shared = check_paired(results)
     os.makedirs(out, exist_ok=True)

@@ -27,7 +27,7 @@ import numpy as np  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
 import homing_gym  # noqa: E402,F401
-from homing_gym.cli import command_parser  # noqa: E402
+from homing_gym.cli import command_parser, seed_value  # noqa: E402
 from homing_gym.panorama import bearing_column  # noqa: E402
 from homing_train.harness.rollout import prepare_policy, rollout  # noqa: E402
 
@@ -85,7 +85,7 @@ def views_figure(env: gym.Env, seed: int, path: Path) -> None:
 def main(argv: list[str] | None = None) -> int:
     parser = command_parser("homing-demo", __doc__)
     parser.add_argument("--out", default="demo", help="output folder")
-    parser.add_argument("--seed", type=int, default=9)
+    parser.add_argument("--seed", type=seed_value, default=9)
     parser.add_argument("--scene", default="arena")
     args = parser.parse_args(argv)
     try:

@@ -26,6 +26,8 @@ import numpy as np
 from tqdm import tqdm
 
 import homing_gym
+from homing_gym.cli import seed_value
+from homing_gym.validation import require_positive
 from homing_gym.env import simulation_settings
 from homing_gym.paths import NoPathError, path_length, shortest_path
 from homing_gym.geometry import wrap_angle
@@ -106,7 +108,7 @@ class EvalResult:
         try:
             with open(path) as f:
                 doc = json.load(f)
-        except (OSError, json.JSONDecodeError) as err:
+        except (OSError, json.JSONDecodeError, UnicodeDecodeError) as err:
             raise ValueError(f"{path}: not a readable result JSON ({err})") from None
         if not isinstance(doc, dict) or doc.get("schema") != SCHEMA:
             raise ValueError(f"{path}: expected a homing-eval result with schema {SCHEMA}, "
@@ -355,6 +357,12 @@ def _indexed_work(item: tuple[int, tuple]) -> tuple[int, EpisodeRecord]:
     return item[0], _work(item[1])
 
 
+def check_env_id(env_id: str) -> None:
+    """``ValueError`` naming ``env_id`` and the package's ids if Gymnasium has no such id."""
+    if env_id not in gym.registry:
+        raise ValueError(f"unknown env id {env_id!r}; homing-gym ids: {list(homing_gym.ENV_IDS)}")
+
+
 def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int = 0,
              env_kwargs: dict[str, Any] | None = None, workers: int = 1,
              params: dict[str, Any] | None = None, bin_width: float = 0.3,
@@ -382,8 +390,10 @@ def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int =
         seeds = list(range(seed, seed + episodes))
     if episodes < 1:
         raise ValueError(f"episodes must be >= 1, got {episodes}")
-    if env_id not in gym.registry:
-        raise ValueError(f"unknown env id {env_id!r}; homing-gym ids: {list(homing_gym.ENV_IDS)}")
+    if not (isinstance(workers, int) and workers >= 1):
+        raise ValueError(f"workers must be >= 1, got {workers!r}")
+    require_positive("bin width", bin_width, "metres")
+    check_env_id(env_id)
     spec = policy_spec(policy, params)
     env_kwargs = dict(env_kwargs or {})
     if spec.kind == "sb3":
@@ -418,9 +428,12 @@ def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int =
 
 
 class _Stream:
-    """An open JSON-lines file of finished episodes, flushed line by line."""
+    """An open JSON-lines file of finished episodes, flushed line by line. A new file
+    that got no episode (the run failed before its first one) is removed on close, so
+    that it cannot block a later ``--resume`` with other settings."""
 
     def __init__(self, path: str, settings: dict, append: bool):
+        self.path, self.append, self.records = path, append, 0
         self.file = open(path, "a" if append else "w")
         if not append:
             self._line(settings)
@@ -431,9 +444,12 @@ class _Stream:
 
     def write_record(self, record: EpisodeRecord) -> None:
         self._line(asdict(record))
+        self.records += 1
 
     def close(self) -> None:
         self.file.close()
+        if not self.append and not self.records:
+            os.remove(self.path)
 
 
 def open_stream(path: str, settings: dict, append: bool = False) -> _Stream:
@@ -496,7 +512,7 @@ def add_policy_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--env", default=DEFAULT_ENV, help="env id")
     parser.add_argument("--env-kwargs", default=None, metavar="JSON",
                         help="keyword arguments of gym.make, a JSON object")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the first episode")
+    parser.add_argument("--seed", type=seed_value, default=0, help="seed of the first episode")
     parser.add_argument("--workers", type=int, default=1, help="parallel processes")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--trust-policy", action="store_true",

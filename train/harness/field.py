@@ -35,7 +35,7 @@ import numpy as np  # noqa: E402
 
 from homing_gym.cli import command_parser  # noqa: E402
 from homing_gym.geometry import wrap_angle  # noqa: E402
-from homing_gym.scenes.base import clearance  # noqa: E402
+from homing_gym.scenes.base import clearances  # noqa: E402
 from homing_gym.topdown import MapCanvas, draw_pose, draw_scale_bar, draw_scene  # noqa: E402
 from homing_train.harness.evaluate import (DEFAULT_ENV, add_policy_arguments,  # noqa: E402
                                            parse_json_kwargs, policy_from_args, run_episodes)
@@ -68,17 +68,28 @@ class FieldResult:
     extra: dict[str, Any] = field(default_factory=dict)
 
 
+#: Most grid points a field may have (each one runs the controller once).
+MAX_GRID_POINTS = 20_000
+
+
 def grid_points(scene, home, spacing: float, margin: float, exclude: float) -> np.ndarray:
     """Cell centres of a ``spacing`` grid over the scene bounds with at least ``margin`` m
     clearance and more than ``exclude`` m from home."""
     if not spacing > 0:
         raise ValueError(f"grid spacing must be positive metres, got {spacing}")
     (xmin, ymin), (xmax, ymax) = scene.bounds
+    cells = math.ceil((xmax - xmin) / spacing) * math.ceil((ymax - ymin) / spacing)
+    if cells > MAX_GRID_POINTS:
+        raise ValueError(f"grid spacing {spacing} m over the {xmax - xmin:g} x {ymax - ymin:g} m "
+                         f"of scene {scene.name!r} gives {cells} points; at most "
+                         f"{MAX_GRID_POINTS} (give a coarser grid)")
     xs = np.arange(xmin + spacing / 2, xmax, spacing)
     ys = np.arange(ymin + spacing / 2, ymax, spacing)
-    pts = [(x, y) for y in ys for x in xs
-           if clearance(scene, (x, y)) >= margin and math.hypot(x - home[0], y - home[1]) > exclude]
-    return np.array(pts, dtype=np.float64).reshape(-1, 2)
+    gx, gy = np.meshgrid(xs, ys)                        # row by row: y outer, x inner
+    pts = np.column_stack([gx.ravel(), gy.ravel()])
+    keep = (clearances(scene, pts) >= margin) & (
+        np.hypot(pts[:, 0] - home[0], pts[:, 1] - home[1]) > exclude)
+    return pts[keep]
 
 
 PROBE_STEPS = 40

@@ -29,11 +29,11 @@ from pathlib import Path
 import gymnasium as gym
 import homing_baselines
 import homing_gym  # noqa: F401  (registers the env ids)
-from homing_gym.cli import command_parser
+from homing_gym.cli import command_parser, seed_value
 from homing_train.extras import missing_extra
 from homing_train.harness.compare import compare
-from homing_train.harness.evaluate import (DEFAULT_ENV, add_backend_arguments, evaluate,
-                                           format_summary)
+from homing_train.harness.evaluate import (DEFAULT_ENV, add_backend_arguments, check_env_id,
+                                           evaluate, format_summary)
 from homing_train.harness.matrix import equal_time_kwargs, matrix_markdown, run_matrix
 from homing_train.harness.policies import shipped_policies
 from homing_train.harness.protocols import PROTOCOLS, protocol
@@ -53,7 +53,7 @@ def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: in
               workers: int = 2, methods: list[str] | None = None, backend: str = "local",
               address: str | None = None) -> dict[str, str]:
     """Evaluate the methods (default: all controllers and shipped policies) and compare."""
-    out.mkdir(parents=True, exist_ok=True)
+    check_env_id(env_id)
     policies = {name: p for name, p in shipped_policies().items()
                 if p.env_id in (None, env_id)}
     if policies and (hint := missing_extra("train")):
@@ -65,6 +65,7 @@ def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: in
     unknown = sorted(set(chosen) - set(candidates))
     if unknown:
         raise ValueError(f"unknown methods {unknown}; available: {candidates}")
+    out.mkdir(parents=True, exist_ok=True)
     paths = []
     for name in chosen:
         shipped = policies.get(name)
@@ -90,7 +91,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--env", default=DEFAULT_ENV, help="env id of the suite")
     parser.add_argument("--episodes", type=int, default=None,
                         help="episodes per method (default 20; see --protocols)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the first episode")
+    parser.add_argument("--seed", type=seed_value, default=0, help="seed of the first episode")
     parser.add_argument("--workers", type=int, default=2, help="parallel processes")
     parser.add_argument("--methods", nargs="+", help="subset of methods (default: all)")
     parser.add_argument("--out", default="results", help="output folder (default: results)")

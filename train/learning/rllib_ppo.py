@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 import gymnasium as gym
 import numpy as np
 
-from homing_gym.cli import IMPORT_VARIABLE, command_parser
+from homing_gym.cli import IMPORT_VARIABLE, command_parser, seed_value
 from homing_train.learning.train import load_hyperparams
 
 if TYPE_CHECKING:
@@ -185,7 +185,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--train-batch-size", type=int, default=None,
                         help="env steps per iteration (default: n_steps x n_envs of ppo.yml)")
     parser.add_argument("--iterations", type=int, default=100)
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=seed_value, default=0)
     parser.add_argument("--out", type=Path, default=None,
                         help="folder for the final checkpoint (algo.save_to_path)")
     args = parser.parse_args(argv)

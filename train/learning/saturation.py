@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import gymnasium as gym
 import numpy as np
 
-from homing_gym.cli import command_parser
+from homing_gym.cli import command_parser, seed_value
 from homing_train.harness.evaluate import parse_json_kwargs
 
 #: ``|tanh(x)|`` above this counts as saturated (the gradient ``1 - tanh^2`` below 0.02).
@@ -110,7 +110,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="gym.make kwargs matching the policy's observation space")
     parser.add_argument("--observations", type=int, default=30,
                         help="episodes whose first observation is used (default 30)")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=seed_value, default=0)
     parser.add_argument("--trust-policy", action="store_true",
                         help="unpickle the zip (runs code from the file)")
     args = parser.parse_args(argv)

@@ -39,7 +39,7 @@ import numpy as np
 import yaml
 
 import homing_gym
-from homing_gym.cli import command_parser
+from homing_gym.cli import command_parser, seed_value
 from homing_train.extras import MissingExtraError, require_extra
 from homing_train.learning import EXTRACTORS
 from homing_train.learning.curriculum import (HOOK, CurriculumSettings, last_stage, mark_stages,
@@ -620,7 +620,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--hp", action="append", default=[], metavar="KEY=VALUE",
                         help="override a hyperparameter (YAML value); repeatable")
     parser.add_argument("--env-kwargs", type=json.loads, help="JSON kwargs of gym.make")
-    parser.add_argument("--seed", type=int)
+    parser.add_argument("--seed", type=seed_value)
     parser.add_argument("--timesteps", type=int)
     parser.add_argument("--n-envs", type=int)
     parser.add_argument("--vec", choices=("subproc", "dummy"))

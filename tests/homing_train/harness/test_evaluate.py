@@ -157,6 +157,55 @@ def test_eval_cli_rejects_bad_input(tmp_path, capsys, argv, message):
     assert message in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("argv, message", [
+    (["--env-kwargs", '{"bogus": 1}'], "unknown keyword arguments ['bogus']"),
+    (["--env-kwargs", '{"scene": "moon"}'], "unknown scene 'moon'"),
+    (["--workers", "0"], "workers must be >= 1"),
+    (["--bin-width", "-1"], "bin width must be a positive number"),
+    (["--seed", "-5"], "a seed is an integer >= 0"),
+])
+def test_a_failed_evaluation_is_one_line_and_leaves_no_file(tmp_path, capsys, argv, message):
+    with pytest.raises(SystemExit) as err:
+        eval_cli.main(["--policy", "oracle", "--episodes", "1", "--quiet", *argv,
+                       "--out", str(tmp_path / "x.json")])
+    assert err.value.code == 2
+    lines = [line for line in capsys.readouterr().err.splitlines() if "error:" in line]
+    assert len(lines) == 1 and message in lines[0]
+    # no header-only episode stream left behind to block a later --resume
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_compare_and_suite_refuse_bad_input_before_writing(tmp_path, capsys):
+    from homing_train.harness import compare as compare_cli
+    from homing_train.harness import suite as suite_cli
+    binary = tmp_path / "binary.json"
+    binary.write_bytes(bytes(range(256)))
+    for argv, message in (([str(binary), "--out", str(tmp_path / "c")], "binary.json: not a "
+                           "readable result JSON"),
+                          ([str(binary), "--trajectories", "-1", "--out", str(tmp_path / "c")],
+                           "trajectories must be >= 0"),
+                          ([str(binary), "--out", str(binary)], "is a file")):
+        with pytest.raises(SystemExit) as err:
+            compare_cli.main(argv)
+        assert err.value.code == 2 and message in capsys.readouterr().err
+    for argv, message in ((["--env", "nope/X-v0"], "unknown env id 'nope/X-v0'"),
+                          (["--methods", "nope"], "unknown methods ['nope']")):
+        with pytest.raises(SystemExit) as err:
+            suite_cli.main([*argv, "--episodes", "1", "--out", str(tmp_path / "suite")])
+        assert err.value.code == 2 and message in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["binary.json"]
+
+
+def test_field_refuses_a_grid_too_fine_to_run(tmp_path, capsys):
+    from homing_train.harness import field as field_cli
+    with pytest.raises(SystemExit) as err:
+        field_cli.main(["--policy", "oracle", "--grid", "1e-6", "--no-return",
+                        "--out", str(tmp_path / "f.png")])
+    assert err.value.code == 2
+    # 2.4 m / 1e-6 m = 2.4 million columns and rows
+    assert "gives 5760000000000 points; at most 20000" in capsys.readouterr().err
+
+
 def test_load_rejects_bad_json(tmp_path):
     bad = tmp_path / "bad.json"
     bad.write_text("{not json")
