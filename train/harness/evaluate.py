@@ -17,6 +17,7 @@ import math
 import multiprocessing as mp
 import os
 import signal
+import socket
 import time
 from dataclasses import asdict, dataclass, field
 from typing import Any, Callable, Sequence
@@ -266,6 +267,22 @@ class _EpisodeActor:
         return _indexed_work(item)
 
 
+def check_ray_address(address: str | None, timeout: float = 5.0) -> None:
+    """``ValueError`` if ``address`` names a host and port (``HOST:PORT`` or
+    ``ray://HOST:PORT``) where nothing accepts a connection within ``timeout`` seconds:
+    Ray itself keeps retrying such an address for minutes."""
+    if not address or address == "auto":
+        return
+    host, _, port = address.removeprefix("ray://").rpartition(":")
+    if not host or not port.isdigit():
+        raise ValueError(f"ray address {address!r}: expected HOST:PORT, ray://HOST:PORT or 'auto'")
+    try:
+        socket.create_connection((host, int(port)), timeout=timeout).close()
+    except OSError as err:
+        raise ValueError(f"ray address {address!r}: nothing answers there ({err}); 'auto' "
+                         f"joins a cluster running on this machine") from None
+
+
 def _ray_records(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
                  tasks: Sequence[tuple], workers: int, address: str | None):
     """``(index, record)`` of every task as Ray actors finish them: ``workers`` actors on
@@ -276,6 +293,7 @@ def _ray_records(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
     from ray.util import ActorPool
 
     if not ray.is_initialized():
+        check_ray_address(address)
         user_modules = {k: v for k, v in os.environ.items() if k == "HOMING_GYM_IMPORT"}
         local = {} if address else {"num_cpus": workers, "object_store_memory": 200 * 2**20,
                                     "include_dashboard": False}

@@ -402,3 +402,21 @@ def test_compare_notes_say_which_rows_differ_in_renderer_and_settings():
         "rows differ in time per episode: 50 s (oracle, distance); 40 s (ppo)")
     same_time = result("ppo", **same, control_period=0.2, max_episode_steps=250)
     assert not any("time" in n for n in settings_notes(rows[:2] + [same_time]))
+
+
+def test_a_ray_address_where_nothing_answers_fails_at_once():
+    import socket
+
+    from homing_train.harness.evaluate import check_ray_address
+    with socket.socket() as s:                     # a port that was free a moment ago
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    with pytest.raises(ValueError, match=f"127.0.0.1:{port}'. nothing answers there"):
+        check_ray_address(f"127.0.0.1:{port}", timeout=2.0)
+    with pytest.raises(ValueError, match="expected HOST:PORT"):
+        check_ray_address("localhost")
+    check_ray_address("auto")                      # left to Ray
+    with socket.socket() as server:                # something that answers
+        server.bind(("127.0.0.1", 0))
+        server.listen()
+        check_ray_address(f"ray://127.0.0.1:{server.getsockname()[1]}")
