@@ -83,7 +83,9 @@ class LocalHomingEnv(HomingEnv):
     in a random direction from home, also collision-free, with a uniform random heading.
     Everything is drawn from the generator seeded by ``reset(seed=...)``.
     ``reset(options={"home": (x, y, yaw), "start": (x, y, yaw)})`` sets either pose
-    instead (metres, radians; e.g. to place the robot on a grid for a homing vector field).
+    instead (metres, radians; e.g. to place the robot on a grid for a homing vector field;
+    the start must leave room for the robot's body, the home must not lie inside a wall
+    or object).
     ``env.unwrapped.set_start_distance((min, max))`` changes the range for the following
     resets (a training curriculum's hook; ``VecEnv.env_method`` reaches it through wrappers).
 
