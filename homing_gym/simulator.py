@@ -42,13 +42,6 @@ from homing_gym.worldmesh import world_mesh
 _STATIC = {"useMaximalCoordinates": True}
 
 
-def _fixed_part(scene: Scene) -> tuple:
-    """What a randomised scene may not change without a rebuild: the floor, the walls'
-    geometry and the fence."""
-    return (scene.bounds, scene.ground_plane, scene.fence,
-            tuple((w.start, w.end, w.height, w.thickness) for w in scene.walls))
-
-
 class Simulator:
     """One PyBullet client holding a scene and the robot."""
 
@@ -79,8 +72,8 @@ class Simulator:
 
     # -- building -------------------------------------------------------------------------
     def _build(self, scene: Scene) -> None:
-        """Make the whole world in an empty client: floor, walls, fence, robot (state
-        saved bare), then landmarks and mesh parts (state saved)."""
+        """Make the whole world in an empty client: floor, walls, fence, robot, landmarks
+        and mesh parts (state saved)."""
         c = self.client
         c.setGravity(0, 0, -9.81)
         c.setTimeStep(self.time_step)
@@ -94,11 +87,6 @@ class Simulator:
         self.fence_ids = ([self._body(s, visible=False) for s in fence_solids(scene)]
                           if scene.fence else [])
         self.robot = Robot(c, self._robot_config)
-        self._bare_state = c.saveState()
-        self._make_objects(scene)
-
-    def _make_objects(self, scene: Scene) -> None:
-        """The landmarks and mesh parts of ``scene``; saves the state."""
         self.landmark_ids = [self._body(landmark_solid(lm)) for lm in scene.landmarks]
         self.mesh_ids = [body for part in scene.meshes
                          for body in self._make_part(part, scene.height_band)]
@@ -151,8 +139,8 @@ class Simulator:
         c, bodies = self.client, []
         faces = part.faces[band_faces(part, band)] if part.collision else part.faces[:0]
         if len(faces):
-            col = c.createCollisionShape(p.GEOM_MESH, vertices=part.vertices.tolist(),
-                                         indices=faces.ravel().tolist(),
+            vertices, indices = _used_vertices(part.vertices, faces)
+            col = c.createCollisionShape(p.GEOM_MESH, vertices=vertices, indices=indices,
                                          flags=p.GEOM_FORCE_CONCAVE_TRIMESH)
             bodies.append(c.createMultiBody(0, col, -1, [0, 0, 0], **_STATIC))
             self._hide(bodies[-1])
@@ -160,11 +148,9 @@ class Simulator:
             levels = np.round(part.face_colors * 16).astype(np.int64)
             keys = (levels[:, 0] * 17 + levels[:, 1]) * 17 + levels[:, 2]
             for key in np.unique(keys):
-                group = part.faces[keys == key]
-                vis = c.createVisualShape(
-                    p.GEOM_MESH, vertices=part.vertices.tolist(),
-                    indices=group.ravel().tolist(),
-                    rgbaColor=[*(levels[keys == key][0] / 16), 1.0])
+                vertices, indices = _used_vertices(part.vertices, part.faces[keys == key])
+                vis = c.createVisualShape(p.GEOM_MESH, vertices=vertices, indices=indices,
+                                          rgbaColor=[*(levels[keys == key][0] / 16), 1.0])
                 bodies.append(c.createMultiBody(0, -1, vis, [0, 0, 0], **_STATIC))
                 c.changeVisualShape(bodies[-1], -1, textureUniqueId=-1)   # no default checker
         return bodies
@@ -199,27 +185,15 @@ class Simulator:
     # -- episodes -------------------------------------------------------------------------
     def reset_world(self, scene: Scene) -> None:
         """Bring the world back to its saved state, switching to ``scene`` if it differs:
-        a scene with the same floor, walls and fence (a randomised scene that changes its
-        landmarks, meshes and colours) rebuilds only those; any other is built anew in an
-        emptied client."""
-        c = self.client
+        a new world is built in the emptied client (PyBullet frees a removed body's
+        collision shapes only on ``resetSimulation``; trajectories are the same as with
+        the bodies removed one by one, checked on the three procedural worlds with both
+        renderers)."""
         if scene == self.scene:
-            c.restoreState(self._state)
+            self.client.restoreState(self._state)
             return
-        if _fixed_part(scene) != _fixed_part(self.scene):
-            c.resetSimulation()
-            self._build(scene)
-        else:
-            for body in self.landmark_ids + self.mesh_ids:
-                c.removeBody(body)
-            c.removeState(self._state)
-            c.restoreState(self._bare_state)
-            for body, wall in zip(self.wall_ids, scene.walls):
-                self._paint(body, wall.color, wall.texture)
-            if scene.ground_plane:
-                self._paint(self.floor_id, scene.floor_color, scene.floor_texture)
-            self.scene = scene
-            self._make_objects(scene)
+        self.client.resetSimulation()
+        self._build(scene)
         if self.caster is not None:
             self.caster = RayCaster(world_mesh(scene), self.sky(scene), self._shadows)
 
@@ -276,6 +250,15 @@ class Simulator:
     @property
     def connected(self) -> bool:
         return self._connected
+
+
+def _used_vertices(vertices: np.ndarray, faces: np.ndarray) -> tuple[list, list]:
+    """The corners that ``faces`` use (in their order in ``vertices``) and the faces'
+    indices into them, as the lists PyBullet's mesh shapes take. PyBullet keeps a
+    reference to every vertex it is given (its ``extractVertices`` never releases
+    them), so a mesh passes only its own corners: that memory is lost for good."""
+    used, inverse = np.unique(faces, return_inverse=True)
+    return vertices[used].tolist(), inverse.ravel().tolist()
 
 
 def _panel_mesh(half) -> dict[str, list]:

@@ -36,3 +36,15 @@ def test_200_make_close_cycles_leak_nothing():
     growth_mb = (psutil.Process().memory_info().rss - rss) / 2**20
     assert not any(p.isConnected(physicsClientId=c) for c in set(clients))
     assert growth_mb < 8, f"memory grew by {growth_mb:.1f} MB over 200 make/close cycles"
+
+
+def test_a_mesh_shape_gets_only_the_corners_its_faces_use():
+    # PyBullet never releases the vertex lists it is given: pass no unused corner
+    from homing_gym.simulator import _used_vertices
+    vertices = np.arange(30, dtype=np.float64).reshape(10, 3)
+    faces = np.array([[7, 2, 9], [9, 2, 4]])
+    corners, indices = _used_vertices(vertices, faces)
+    assert len(corners) == 4                                   # 2, 4, 7, 9
+    triangles = np.asarray(corners)[np.reshape(indices, (-1, 3))]
+    assert np.array_equal(triangles, vertices[faces])         # the same triangles, in order
+
