@@ -505,6 +505,12 @@ class HomingEnv(gym.Env):
         if hasattr(self, "sim"):
             self.sim.close()
 
+    def __reduce_ex__(self, protocol):
+        # a copy would share the PyBullet client (and disconnect it when collected)
+        raise TypeError(f"{type(self).__name__} cannot be copied or pickled: it holds a live "
+                        f"PyBullet world; make another with gym.make(env.spec), and give "
+                        f"vector envs functions that make envs")
+
     def _check_open(self) -> None:
         if hasattr(self, "sim") and not self.sim.connected:
             raise gym.error.ClosedEnvironmentError(

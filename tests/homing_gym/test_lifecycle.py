@@ -48,3 +48,20 @@ def test_a_mesh_shape_gets_only_the_corners_its_faces_use():
     triangles = np.asarray(corners)[np.reshape(indices, (-1, 3))]
     assert np.array_equal(triangles, vertices[faces])         # the same triangles, in order
 
+
+
+@pytest.mark.parametrize("copier", ["deepcopy", "copy", "pickle"])
+def test_an_env_refuses_to_be_copied_rather_than_share_its_world(copier):
+    import copy
+    import pickle
+    env = gym.make("homing_gym/LocalHoming-v0", panorama_shape=(16, 64))
+    env.reset(seed=0)
+    copy_of = {"deepcopy": copy.deepcopy, "copy": lambda e: copy.copy(e.unwrapped),
+               "pickle": pickle.dumps}[copier]
+    with pytest.raises(TypeError, match="cannot be copied or pickled.*gym.make\\(env.spec\\)"):
+        copy_of(env)
+    env.step(np.zeros(2, np.float32))          # the original still has its world
+    again = gym.make(env.spec)                 # what the message says works
+    again.reset(seed=0)
+    again.close()
+    env.close()
