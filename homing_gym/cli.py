@@ -14,6 +14,7 @@ import argparse
 import importlib
 import os
 import re
+import sys
 
 #: Comma-separated modules that ``import homing_gym`` imports (set by ``--import``).
 IMPORT_VARIABLE = "HOMING_GYM_IMPORT"
@@ -56,7 +57,13 @@ def plain(text: str) -> str:
 
 
 def import_user_module(name: str) -> None:
-    """Import ``name`` here and, through :data:`IMPORT_VARIABLE`, in worker processes."""
+    """Import ``name`` here and, through :data:`IMPORT_VARIABLE`, in worker processes. The
+    current folder is searched too (last, so it shadows no installed module), as
+    ``python -m`` would: a console script's path lacks it. Spawned workers inherit the
+    path."""
+    here = os.getcwd()
+    if here not in sys.path:
+        sys.path.append(here)
     try:
         importlib.import_module(name)
     except ImportError as err:

@@ -85,3 +85,16 @@ def test_textures_are_written_where_asked_and_match_the_shipped_ones(tmp_path):
     for name in written:      # the pixels: the PNG encoder's bytes may vary by version
         assert np.array_equal(cv2.imread(str(tmp_path / name)),
                               cv2.imread(str(TEXTURE_DIR / name))), name
+
+
+def test_import_finds_a_module_in_the_current_folder(tmp_path, monkeypatch):
+    import sys
+
+    from homing_gym.cli import import_user_module
+    (tmp_path / "my_world_here.py").write_text("LOADED = True\n")
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "path", [p for p in sys.path if p not in ("", str(tmp_path))])
+    monkeypatch.delenv("HOMING_GYM_IMPORT", raising=False)
+    import_user_module("my_world_here")
+    assert sys.modules["my_world_here"].LOADED
+    assert sys.path[-1] == str(tmp_path)                   # searched last: shadows nothing

@@ -47,6 +47,19 @@ def test_sb3_make_vec_env_and_a_short_ppo_run():
     venv.close()
 
 
+def test_sb3_default_cnn_takes_the_pages_36_pixel_panoramas():
+    # the page's first snippet: SB3's own NatureCNN, which needs images >= 36 pixels high
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.env_util import make_vec_env
+
+    venv = make_vec_env("homing_gym/LocalHoming-v0", n_envs=2, seed=0,
+                        env_kwargs={"panorama_shape": (36, 128), "action_type": "discrete"})
+    model = PPO("MultiInputPolicy", venv, n_steps=16, batch_size=16, n_epochs=1, device="cpu")
+    model.learn(32)
+    assert model.num_timesteps == 32
+    venv.close()
+
+
 def test_rlzoo_hyperparameter_file_builds_the_package_extractor():
     from homing_train.learning.extractor import PanoramaGoalExtractor
 
