@@ -111,6 +111,12 @@ class EvalResult:
                 doc = json.load(f)
         except (OSError, json.JSONDecodeError, UnicodeDecodeError) as err:
             raise ValueError(f"{path}: not a readable result JSON ({err})") from None
+        if isinstance(doc, dict) and "protocol" in doc and "settings" in doc:
+            folder = (os.path.dirname(path) if os.path.basename(path) == "cell.json"
+                      else os.path.splitext(path)[0])
+            raise ValueError(f"{path}: a protocol cell (homing-eval --protocol), not an "
+                             f"episode result; compare its settings' results, the other "
+                             f".json files in {folder}/")
         if not isinstance(doc, dict) or doc.get("schema") != SCHEMA:
             raise ValueError(f"{path}: expected a homing-eval result with schema {SCHEMA}, "
                              f"got schema {doc.get('schema') if isinstance(doc, dict) else None!r}")
@@ -520,13 +526,17 @@ def parse_json_kwargs(text: str | None, option: str = "--env-kwargs") -> dict[st
     return value
 
 
-def add_policy_arguments(parser: argparse.ArgumentParser) -> None:
-    """The ``--policy/--param/--env/--env-kwargs/--seed/--workers`` options."""
+def add_policy_arguments(parser: argparse.ArgumentParser,
+                         controllers_only: bool = False) -> None:
+    """The ``--policy/--param/--env/--env-kwargs/--seed/--workers`` options
+    (``controllers_only``: the command takes scripted controllers, not model zips)."""
     parser.add_argument("--policy", required=True,
-                        help="registered controller name or path to a stable-baselines3 .zip")
+                        help="registered scripted controller name" if controllers_only else
+                        "registered controller name or path to a stable-baselines3 .zip")
     parser.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
-                        help="controller parameter override (repeatable); for an SB3 model "
-                        "only deterministic=false (sample actions, seeded per episode)")
+                        help="controller parameter override (repeatable)" + (
+                            "" if controllers_only else "; for an SB3 model only "
+                            "deterministic=false (sample actions, seeded per episode)"))
     parser.add_argument("--env", default=DEFAULT_ENV, help="env id")
     parser.add_argument("--env-kwargs", default=None, metavar="JSON",
                         help="keyword arguments of gym.make, a JSON object")

@@ -207,7 +207,7 @@ def plot_field(result: FieldResult, path: str, size: int = 480) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     parser = command_parser("homing-field", __doc__)
-    add_policy_arguments(parser)
+    add_policy_arguments(parser, controllers_only=True)
     parser.add_argument("--scene", default=None, help="scene name (overrides --env-kwargs)")
     parser.add_argument("--protocol", choices=sorted(PROTOCOLS),
                         help="the field in this protocol's first setting: its env, env kwargs "

@@ -51,8 +51,12 @@ def suite_methods(env_id: str) -> list[str]:
 
 def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: int = 0,
               workers: int = 2, methods: list[str] | None = None, backend: str = "local",
-              address: str | None = None) -> dict[str, str]:
-    """Evaluate the methods (default: all controllers and shipped policies) and compare."""
+              address: str | None = None, success_on: str = "stop") -> dict[str, str]:
+    """Evaluate the methods (default: all controllers and shipped policies) and compare,
+    every row with the same success rule ``success_on`` (``"stop"``: the agent stopped
+    at the goal, the protocols' rule; ``"reach"``: came within the radius at any time)."""
+    if success_on not in ("stop", "reach"):
+        raise ValueError(f"unknown success rule {success_on!r}; allowed: 'stop', 'reach'")
     check_env_id(env_id)
     policies = {name: p for name, p in shipped_policies().items()
                 if p.env_id in (None, env_id)}
@@ -67,12 +71,13 @@ def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: in
         raise ValueError(f"unknown methods {unknown}; available: {candidates}")
     out.mkdir(parents=True, exist_ok=True)
     paths = []
+    rule = {"success_on": success_on}        # one rule for every row, whatever it trained with
     for name in chosen:
         shipped = policies.get(name)
         policy, kwargs, params = (
             str(shipped.path),
-            equal_time_kwargs({}, shipped.env_kwargs, gym.spec(env_id).max_episode_steps),
-            shipped.params) if shipped else (name, {}, {})
+            equal_time_kwargs(rule, shipped.env_kwargs, gym.spec(env_id).max_episode_steps),
+            shipped.params) if shipped else (name, rule, {})
         result = evaluate(policy, env_id, episodes=episodes, seed=seed, env_kwargs=kwargs,
                           workers=workers, params=params, backend=backend, address=address)
         print(format_summary(result))
@@ -94,6 +99,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=seed_value, default=0, help="seed of the first episode")
     parser.add_argument("--workers", type=int, default=2, help="parallel processes")
     parser.add_argument("--methods", nargs="+", help="subset of methods (default: all)")
+    parser.add_argument("--success-on", choices=("stop", "reach"), default="stop",
+                        help="the success rule of every row (without --protocols): stopped at "
+                        "the goal, or came within its radius at any time")
     parser.add_argument("--out", default="results", help="output folder (default: results)")
     parser.add_argument("--resume", action="store_true",
                         help="with --protocols: keep the episodes already streamed into --out "
@@ -119,7 +127,7 @@ def main(argv: list[str] | None = None) -> int:
         args.episodes = 20
     try:
         written = run_suite(Path(args.out), args.env, args.episodes, args.seed, args.workers,
-                            args.methods, args.backend, args.ray_address)
+                            args.methods, args.backend, args.ray_address, args.success_on)
     except ValueError as err:
         parser.exit(2, f"homing-suite: error: {err}\n")
     print(Path(written["table"]).read_text())

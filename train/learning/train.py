@@ -646,6 +646,11 @@ def main(argv: list[str] | None = None) -> int:
             if args.timesteps:
                 saved["timesteps"] = args.timesteps
             config = TrainConfig(**saved)
+            if latest_checkpoint(run) is None:    # starting over would overwrite model.zip
+                raise ValueError(f"--resume {run}: no checkpoint in {run / 'checkpoints'} to "
+                                 f"continue from (one is saved every checkpoint_freq = "
+                                 f"{config.checkpoint_freq} steps and when a run is "
+                                 f"interrupted); start a new run with another --out")
         else:
             settings = load_hyperparams(args.env, args.hyperparams)
             settings.update(parse_overrides(args.hp))

@@ -310,6 +310,33 @@ def test_the_suite_gives_a_shipped_policy_the_controllers_time(monkeypatch, tmp_
     assert kwargs["control_period"] == 0.2 and kwargs["max_episode_steps"] == 250
 
 
+@pytest.mark.parametrize("rule", ["stop", "reach"])
+def test_every_row_of_the_suite_has_one_success_rule(monkeypatch, tmp_path, rule):
+    # ppo_procedural trained with success_on="stop"; a controller row has no rule of its
+    # own: both get the suite's
+    from homing_train.harness import suite
+
+    seen = {}
+
+    class Stub:
+        def save(self, path):
+            pass
+
+    def fake_evaluate(policy, env_id, env_kwargs=None, **kwargs):
+        seen[policy.split("/")[-1]] = dict(env_kwargs or {})
+        if len(seen) == 2:
+            raise KeyboardInterrupt      # the arguments are all this test needs
+        return Stub()
+
+    monkeypatch.setattr(suite, "evaluate", fake_evaluate)
+    monkeypatch.setattr(suite, "format_summary", lambda result: "")
+    with pytest.raises(KeyboardInterrupt):
+        suite.run_suite(tmp_path, episodes=1, workers=1, methods=["warping", "ppo_procedural"],
+                        success_on=rule)
+    assert {name: kwargs["success_on"] for name, kwargs in seen.items()} == {
+        "warping": rule, "ppo_procedural.zip": rule}
+
+
 def _without_wall_time(result):
     return [{k: v for k, v in dataclasses.asdict(e).items() if k != "wall_time"}
             for e in result.episodes]

@@ -72,6 +72,18 @@ def test_resume_continues_the_step_counter(tmp_path):
     assert list(np.load(run / "evaluations.npz")["timesteps"]) == [128, 256]
 
 
+def test_resume_without_a_checkpoint_refuses_rather_than_start_over(tmp_path, capsys):
+    run = tmp_path / "run"
+    main(["--timesteps", "64", "--out", str(run), *TINY, "--hp", "checkpoint_freq=1000"])
+    assert latest_checkpoint(run) is None
+    finished = (run / "model.zip").read_bytes()
+    with pytest.raises(SystemExit) as err:
+        main(["--resume", str(run), "--timesteps", "128", "--no-progress"])
+    assert err.value.code == 2
+    assert "no checkpoint in" in capsys.readouterr().err
+    assert (run / "model.zip").read_bytes() == finished        # the finished model is kept
+
+
 def test_hyperparameters_merge_and_reject_unknown_keys(tmp_path):
     settings = load_hyperparams("homing_gym/LocalHoming-v0")
     assert settings["env_kwargs"] == {"scene": "random_arena"} and settings["n_steps"] == 256
