@@ -171,7 +171,8 @@ class Scene:
             hx, hy = lm.footprint_half_size
             if not (xmin <= x - hx and x + hx <= xmax and ymin <= y - hy and y + hy <= ymax):
                 raise ValueError(
-                    f"scene {self.name!r}: landmark {lm.name or ''} at {lm.position!r} "
+                    f"scene {self.name!r}: landmark {lm.name + ' ' if lm.name else ''}at "
+                    f"{lm.position!r} "
                     f"(footprint half size {hx:.3f} x {hy:.3f} m) lies outside the scene "
                     f"bounds x in [{xmin}, {xmax}], y in [{ymin}, {ymax}]")
         _check_color(f"scene {self.name!r} floor", self.floor_color)

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import os
 import sys
-import warnings
 from typing import Sequence
 
 import cv2
@@ -103,8 +102,8 @@ def check_paired(results: Sequence[EvalResult]) -> list[int]:
     seeds = [set(e.seed for e in r.episodes) for r in results]
     shared = sorted(set.intersection(*seeds))
     if any(s != seeds[0] for s in seeds):
-        warnings.warn(f"results cover different episode seeds; {len(shared)} shared",
-                      stacklevel=2)
+        print(f"note: the results cover different episode seeds; {len(shared)} shared "
+              f"(the plots of paired episodes use those)", file=sys.stderr)
     return shared
 
 

@@ -445,7 +445,14 @@ def main(argv: list[str] | None = None) -> int:
             target = Path(args.readme).parent / args.matrix_json
             cells = load_cells(target)
             for path in args.merge:
-                cells = merged_cells(cells, load_cells(path))
+                newer = load_cells(path)
+                before = {(c.protocol, c.method): c.summary["episodes"] for c in cells}
+                for cell in newer:
+                    old = before.get((cell.protocol, cell.method), 0)
+                    if cell.summary["episodes"] < old:
+                        print(f"note: {cell.protocol} x {cell.method}: {old} episodes "
+                              f"replaced by the {cell.summary['episodes']} of {path}")
+                cells = merged_cells(cells, newer)
             write_matrix(cells, target.parent)
             print(f"merged {len(args.merge)} run(s) into {target}")
         else:
