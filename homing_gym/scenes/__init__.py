@@ -63,7 +63,9 @@ def scene_factory(scene: "str | Scene | SceneFactory") -> SceneFactory:
     if not isinstance(scene, str) or scene not in _SCENES:
         raise ValueError(f"unknown scene {scene!r}; allowed: {available_scenes()}, "
                          f"'{MESH_PREFIX}PATH' for a mesh file, a Scene or a SceneFactory "
-                         f"(a list of names is for homing-train: env k of its vector env builds name k mod n)")
+                         f"(a list of names is for homing-train: env k of its vector env "
+                         f"builds name k mod n); a scene your module registers needs "
+                         f"--import MODULE on the command line")
     return _SCENES[scene]
 
 
