@@ -11,12 +11,14 @@ path); the scene of each shown episode is rebuilt with ``env.reset(seed)``.
 
 from __future__ import annotations
 
+import inspect
 import os
 import sys
 from typing import Sequence
 
 import cv2
 import gymnasium as gym
+from gymnasium.envs.registration import load_env_creator
 import matplotlib
 
 matplotlib.use("Agg")
@@ -60,6 +62,27 @@ def markdown_table(results: Sequence[EvalResult]) -> str:
 NEUTRAL_KEYS = ("obs_keys",)
 
 
+def success_rule(result: EvalResult) -> tuple:
+    """``(env id, success_on, success_radius)`` a result was scored under: its env kwargs,
+    else the env's defaults (``None`` where the env has no such argument)."""
+    params = inspect.signature(load_env_creator(gym.spec(result.env_id).entry_point)).parameters
+    return (result.env_id, *(result.env_kwargs.get(
+        key, params[key].default if key in params else None)
+        for key in ("success_on", "success_radius")))
+
+
+def check_one_rule(results: Sequence[EvalResult]) -> None:
+    """``ValueError`` naming each row's rule if the results were not all scored by one
+    success rule (the same env, ``success_on`` and ``success_radius``)."""
+    rules = [(r.policy, success_rule(r)) for r in results]
+    if len({rule for _, rule in rules}) > 1:
+        raise ValueError("the results were scored under different success rules, so their "
+                         "success rates do not compare: " + "; ".join(
+                             f"{name}: {env}, success_on={on!r}, success_radius={radius!r}"
+                             for name, (env, on, radius) in rules)
+                         + " (homing-suite --success-on gives every row one rule)")
+
+
 def settings_notes(results: Sequence[EvalResult]) -> list[str]:
     """Lines saying where the rows' envs differ: the renderer, the time an episode may
     last (:func:`~homing_train.harness.matrix.episode_seconds`), and the settings of rows
@@ -97,14 +120,15 @@ def settings_notes(results: Sequence[EvalResult]) -> list[str]:
     return notes
 
 
-def check_paired(results: Sequence[EvalResult]) -> list[int]:
-    """Seeds present in every result (the paired episodes); warns if they differ."""
+def shared_seeds(results: Sequence[EvalResult]) -> tuple[list[int], str | None]:
+    """Seeds present in every result (the paired episodes), and a note when the results
+    cover different seeds."""
     seeds = [set(e.seed for e in r.episodes) for r in results]
     shared = sorted(set.intersection(*seeds))
     if any(s != seeds[0] for s in seeds):
-        print(f"note: the results cover different episode seeds; {len(shared)} shared "
-              f"(the plots of paired episodes use those)", file=sys.stderr)
-    return shared
+        return shared, (f"the results cover different episode seeds, {len(shared)} shared: "
+                        f"the rows are not paired episode by episode")
+    return shared, None
 
 
 def _finish(fig, ax, title: str, path: str) -> None:
@@ -210,14 +234,15 @@ def compare(paths: Sequence[str], out: str, trajectories: int = 3) -> dict[str, 
     if os.path.exists(out) and not os.path.isdir(out):
         raise ValueError(f"--out {out!r} is a file; give a folder")
     results = [EvalResult.load(p) for p in paths]
-    shared = check_paired(results)
+    check_one_rule(results)
+    shared, unpaired = shared_seeds(results)
     os.makedirs(out, exist_ok=True)
     written = {"table": os.path.join(out, "table.md"),
                "success_vs_distance": os.path.join(out, "success_vs_distance.png"),
                "final_distance": os.path.join(out, "final_distance.png")}
     with open(written["table"], "w") as f:
         f.write(markdown_table(results))
-        notes = settings_notes(results)
+        notes = settings_notes(results) + ([unpaired] if unpaired else [])
         if notes:
             f.write("\n" + "".join(f"Note: {n}.\n" for n in notes))
     plot_success_vs_distance(results, written["success_vs_distance"])

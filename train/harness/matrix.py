@@ -93,6 +93,13 @@ def cell_methods(protocol: Protocol) -> list[str]:
 
 #: Settings a shipped policy keeps from its own record in every protocol.
 POLICY_OWN = ("renderer", "physics_substeps", "supersampling")
+#: What else a policy's record may bring where the setting is silent: the format of its
+#: input and output, its control period (its step cap becomes the same time) and its
+#: training reward (which decides no episode). Anything else it recorded (success
+#: radius, start distances, speeds, stop threshold, lighting, noise, camera, odometry
+#: frame, ...) would change the task, so it is the setting's, else the env's default.
+POLICY_FORMAT = ("panorama_shape", "action_type", "control_period", "obs_keys", "reward",
+                 "episodes_per_world")
 
 
 def episode_seconds(env_id: str, env_kwargs: dict) -> float | None:
@@ -113,7 +120,8 @@ def equal_time_kwargs(setting_kwargs: dict, recorded: dict, default_steps: int |
     same time at the policy's control period. The cap the policy was trained with (in
     ``recorded``) is never used: it would give a policy more or less time than the
     controllers beside it."""
-    merged = {**recorded, **setting_kwargs,
+    merged = {**{key: recorded[key] for key in POLICY_FORMAT if key in recorded},
+              **setting_kwargs,
               **{key: recorded[key] for key in POLICY_OWN if key in recorded}}
     steps = setting_kwargs.get("max_episode_steps", default_steps)
     merged.pop("max_episode_steps", None)

@@ -219,6 +219,9 @@ HOMING_METHODS = ("oracle", "random", "snapshot", "warping", "distance", POLICIE
 #: Held out from every shipped policy's training: seeds of the procedural worlds far from
 #: the training seeds, and scenes it never saw.
 UNSEEN_SEED = 10_000_000
+#: ``local-common``'s seeds (v3): clear of every training seed (a training env ``i``
+#: starts in the world of seed ``seed + i``) and of ``unseen``'s.
+COMMON_SEED = 20_000_000
 #: The worlds of ``local-common`` v2: the paper scenes and the procedural worlds.
 COMMON_SCENES = ("arena", "hallway", "lab", "house", "random_rooms", "random_nature")
 PROCEDURAL = ("random_arena", "random_rooms", "random_nature")
@@ -228,6 +231,11 @@ def _held_out(episodes: int, seed: int) -> list[Task]:
     """Seeds from :data:`UNSEEN_SEED` on: procedural worlds no policy trained on, and
     homes and starts that no other protocol draws."""
     return [(UNSEEN_SEED + seed + i, None, None) for i in range(episodes)]
+
+
+def _common(episodes: int, seed: int) -> list[Task]:
+    """Seeds from :data:`COMMON_SEED` on: no training run starts in these worlds."""
+    return [(COMMON_SEED + seed + i, None, None) for i in range(episodes)]
 
 PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
     Protocol(
@@ -333,10 +341,12 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
             "localisation on an HRP robot; ours: WorkLocations-v0 in our house model in "
             "closed loop, stopped within 0.10 m"),)),
     Protocol(
-        "local-common", 2, "one LocalHoming suite for every homing method and policy: "
+        "local-common", 3, "one LocalHoming suite for every homing method and policy: "
         "arena, hallway, lab, house and the procedural random_rooms and random_nature, "
-        "homes anywhere; ray cast, 1/120 s physics (v1: the first four scenes, TinyRenderer)",
-        tuple(Setting(scene, LOCAL, {"scene": scene}, simulation=V2_SIMULATION)
+        f"homes anywhere, seeds from {COMMON_SEED}; ray cast, 1/120 s physics (v2: seeds "
+        "from 0, whose first procedural worlds were the first worlds of the training "
+        "envs; v1: the first four scenes, TinyRenderer)",
+        tuple(Setting(scene, LOCAL, {"scene": scene}, _common, V2_SIMULATION)
               for scene in COMMON_SCENES),
         HOMING_METHODS, episodes=5),
     Protocol(

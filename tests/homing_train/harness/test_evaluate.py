@@ -230,6 +230,26 @@ def test_compare_writes_table_and_pngs(tmp_path):
         assert (tmp_path / "cmp" / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+def test_compare_refuses_rows_scored_under_different_rules_and_notes_unpaired_seeds(tmp_path):
+    from homing_train.harness.compare import compare
+    runs = {"stop": ({"success_on": "stop"}, 0), "reach": ({}, 0),          # reach: the default
+            "wide": ({"success_radius": 0.3}, 0), "later": ({}, 5)}
+    paths = {}
+    for name, (kwargs, seed) in runs.items():
+        r = evaluate("oracle", ENV_ID, episodes=2, seed=seed, progress=False,
+                     env_kwargs={"max_episode_steps": 40, **kwargs})
+        paths[name] = str(tmp_path / f"{name}.json")
+        r.save(paths[name])
+    for other in ("stop", "wide"):
+        with pytest.raises(ValueError, match="different success rules") as err:
+            compare([paths["reach"], paths[other]], str(tmp_path / "cmp"))
+        assert "success_on='reach', success_radius=0.15" in str(err.value)
+    assert not (tmp_path / "cmp").exists()
+    compare([paths["reach"], paths["later"]], str(tmp_path / "cmp"))   # default == explicit
+    assert ("the results cover different episode seeds, 0 shared"
+            in (tmp_path / "cmp" / "table.md").read_text())
+
+
 @pytest.mark.slow
 def test_field_of_oracle_points_home_and_random_does_not(tmp_path):
     out = tmp_path / "field.png"

@@ -65,6 +65,17 @@ def test_a_policy_with_a_longer_control_period_gets_the_same_time():
     assert same_period["max_episode_steps"] == 500
 
 
+def test_a_policys_record_cannot_change_the_task():
+    recorded = {"panorama_shape": [16, 128], "action_type": "discrete",
+                "success_radius": 0.3, "start_distance": [0.3, 0.5], "stop_threshold": 0.5,
+                "max_speed": 0.6, "lighting_change": 0.0, "odometry_origin": "home"}
+    merged = equal_time_kwargs({"scene": "arena", "success_on": "stop",
+                                "lighting_change": 0.3}, recorded, 500)
+    assert merged == {"panorama_shape": [16, 128], "action_type": "discrete",
+                      "scene": "arena", "success_on": "stop", "lighting_change": 0.3,
+                      "max_episode_steps": 500}
+
+
 def test_a_policy_keeps_its_own_renderer_and_physics():
     recorded = {"renderer": "tiny", "physics_substeps": 24, "panorama_shape": [32, 128]}
     merged = equal_time_kwargs({"scene": "random_rooms", "renderer": "raycast",
@@ -92,6 +103,14 @@ def test_unseen_worlds_are_held_out_seeds_of_every_procedural_world():
     for setting in unseen.settings:            # every world's episodes its own (v3)
         seeds = [seed for seed, _, _ in setting.episode_tasks(5, 0)]
         assert all(seed >= 10_000_000 for seed in seeds) and not common & set(seeds)
+
+
+def test_local_common_starts_in_no_world_a_training_env_started_in():
+    # a training env i of a run with seed s starts in the world of seed s + i; shipped
+    # runs used seeds below a million (and resumed at step counts below that)
+    seeds = [seed for s in protocol("local-common").settings
+             for seed, _, _ in s.episode_tasks(17, 0)]
+    assert min(seeds) >= 20_000_000
 
 
 def test_policies_expand_to_the_shipped_policies_of_the_protocols_env():
