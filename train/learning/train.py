@@ -41,6 +41,7 @@ import yaml
 import homing_gym
 from homing_gym.cli import command_parser, seed_value
 from homing_train.extras import MissingExtraError, require_extra
+from homing_train.harness.protocols import UNSEEN_SEED
 from homing_train.learning import EXTRACTORS
 from homing_train.learning.curriculum import (HOOK, CurriculumSettings, last_stage, mark_stages,
                                               plot_training_success)
@@ -52,6 +53,42 @@ HYPERPARAMS = Path(str(resources.files("homing_train.learning") / "hyperparams" 
 EVAL_SEED_OFFSET = 1_000_000
 IMITATION_SEED_OFFSET = 2_000_000
 PRETRAIN_SEED_OFFSET = 3_000_000
+
+
+def seed_ranges(config: "TrainConfig", done_steps: int = 0) -> dict[str, range]:
+    """The episode seeds a run (resumed after ``done_steps``) draws worlds from: its
+    training envs (env ``i`` starts in the world of its seed), the evaluation callback's
+    held-out training worlds, DAgger's and pretraining's."""
+    s, scenes = config.seed, config.n_scenes
+    imitation = max(config.imitation_iterations, 1) * config.imitation_episodes
+    pretraining = config.pretrain_scenes + config.pretrain_scenes // 4 + 1 if (
+        config.pretrain_samples) else 0
+    return {"training": range(s + done_steps, s + done_steps + config.n_envs),
+            "evaluation": range(s + EVAL_SEED_OFFSET, s + EVAL_SEED_OFFSET + scenes),
+            "imitation": range(s + IMITATION_SEED_OFFSET, s + IMITATION_SEED_OFFSET
+                               + (imitation if config.imitation_iterations else 0)),
+            "pretraining": range(s + PRETRAIN_SEED_OFFSET, s + PRETRAIN_SEED_OFFSET
+                                 + pretraining)}
+
+
+def check_seed_ranges(config: "TrainConfig", done_steps: int = 0) -> None:
+    """``ValueError`` if a run would draw worlds the protocols hold out (seeds from
+    ``unseen``'s 10,000,000 on) or train on the worlds it selects models on."""
+    ranges = {name: r for name, r in seed_ranges(config, done_steps).items() if len(r)}
+    too_high = [f"{name} {r.start}-{r.stop - 1}" for name, r in ranges.items()
+                if r.stop > UNSEEN_SEED]
+    if too_high:
+        raise ValueError(f"seed {config.seed} would draw held-out worlds (the protocols' "
+                         f"seeds from {UNSEEN_SEED}): {', '.join(too_high)}; use a smaller "
+                         f"--seed")
+    names = list(ranges)
+    for i, a in enumerate(names):
+        for b in names[i + 1:]:
+            if ranges[a].start < ranges[b].stop and ranges[b].start < ranges[a].stop:
+                raise ValueError(f"the {a} seeds {ranges[a].start}-{ranges[a].stop - 1} "
+                                 f"overlap the {b} seeds {ranges[b].start}-"
+                                 f"{ranges[b].stop - 1} (after {done_steps} steps): the run "
+                                 f"would train on worlds it evaluates on; use fewer steps")
 
 
 @dataclass
@@ -479,15 +516,16 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
     if curriculum is not None:
         check_curriculum(made, curriculum)
     probe.close()
+    checkpoint = latest_checkpoint(out) if resume else None
+    # a resumed run draws new training episodes: its envs are seeded past the steps done
+    done_steps = checkpoint_steps(checkpoint) if checkpoint is not None else 0
+    check_seed_ranges(config, done_steps)
     out.mkdir(parents=True, exist_ok=True)
     (out / "config.yml").write_text(yaml.safe_dump(asdict(config), sort_keys=False))
     with open(out / "command.txt", "a") as f:
         # the installed command's name, not this machine's path to it
         f.write((command or shlex.join(["homing-train", *sys.argv[1:]])) + "\n")
     (out / "versions.json").write_text(json.dumps(versions(), indent=2))
-    checkpoint = latest_checkpoint(out) if resume else None
-    # a resumed run draws new training episodes: its envs are seeded past the steps done
-    done_steps = checkpoint_steps(checkpoint) if checkpoint is not None else 0
     report_dir = Path(tempfile.mkdtemp(prefix="homing-train-workers-"))
     env = make_vec(config, config.n_envs, config.seed + done_steps, report_dir)
     eval_env = make_vec(TrainConfig(**{**asdict(config), "vec": "dummy"}), config.n_scenes,

@@ -1,6 +1,7 @@
 """homing-train: smoke runs with both extractors, save/load round trip, --resume."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -82,6 +83,26 @@ def test_resume_without_a_checkpoint_refuses_rather_than_start_over(tmp_path, ca
     assert err.value.code == 2
     assert "no checkpoint in" in capsys.readouterr().err
     assert (run / "model.zip").read_bytes() == finished        # the finished model is kept
+
+
+def test_training_never_draws_held_out_worlds_or_its_own_evaluation_worlds():
+    import yaml
+
+    from homing_train.learning.train import TrainConfig, check_seed_ranges, seed_ranges
+    shipped = sorted(Path(__file__).parents[3].glob("train/shipped/*.yml"))
+    assert shipped
+    for path in shipped:                       # every shipped run passes, from the start
+        recorded = yaml.safe_load(path.read_text())["config"]
+        config = TrainConfig(**{**recorded, "init_policy": None})   # a file of its machine
+        check_seed_ranges(config, 0)
+        check_seed_ranges(config, config.timesteps - config.n_envs)
+    config = TrainConfig(**{**yaml.safe_load(shipped[0].read_text())["config"], "seed": 0,
+                            "n_envs": 8, "init_policy": None})
+    assert seed_ranges(config, 1000)["training"] == range(1000, 1008)
+    with pytest.raises(ValueError, match="overlap the evaluation seeds 1000000"):
+        check_seed_ranges(config, 999_996)     # a resume just before a million steps
+    with pytest.raises(ValueError, match="held-out worlds .* from 10000000"):
+        check_seed_ranges(TrainConfig(**{**vars(config), "seed": 9_500_000}), 0)
 
 
 def test_hyperparameters_merge_and_reject_unknown_keys(tmp_path):
