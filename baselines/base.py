@@ -44,6 +44,10 @@ class Controller(ABC):
     name: ClassVar[str] = ""
     #: True only for oracle controllers: the harness then calls :meth:`attach_env`.
     needs_env: ClassVar[bool] = False
+    #: What the method knows beyond the robot's own images and odometry (ground truth
+    #: from the simulator or the scene), named beside its row in every table; "" if
+    #: nothing.
+    privileged: ClassVar[str] = ""
     #: True when every move heads for the controller's home estimate, so the move's
     #: direction is :attr:`last_home_direction`. Controllers that first probe (distance
     #: estimation takes a measuring step) set False and set the attribute themselves.

@@ -69,6 +69,8 @@ class MultiResController(Controller):
     vfov_deg: float = 60.0
 
     envs: ClassVar[tuple[str, ...] | None] = ("homing_gym/WorkLocations-v0",)
+    privileged: ClassVar[str] = ("the taught maps' 3-D feature points and target poses, "
+                                 "from the scene (map_points, map_pose)")
 
     def validate(self) -> None:
         if not (5 <= self.front_fov_deg <= 180):

@@ -38,6 +38,7 @@ class OracleController(Controller):
     margin: float = 0.22
 
     needs_env: ClassVar[bool] = True
+    privileged: ClassVar[str] = "true poses and the world's map"
 
     def validate(self) -> None:
         for key in ("step_length", "arrive_tolerance", "heading_tolerance", "margin"):

@@ -263,9 +263,11 @@ def matrix_markdown(cells: Sequence[Cell]) -> str:
     protocols = list(dict.fromkeys(c.protocol for c in cells))
     methods = list(dict.fromkeys(c.method for c in cells))
     by = {(c.protocol, c.method): c for c in cells}
-    privileged = {m: "; ".join(dict.fromkeys(c.privileged for c in cells
-                                             if c.method == m and c.privileged))
-                  for m in methods}
+    privileged = {m: "; ".join(dict.fromkeys(
+        p for p in [c.privileged for c in cells if c.method == m]
+        + ([homing_baselines.controller_class(m).privileged]
+           if m in homing_baselines.available() else []) if p))
+        for m in methods}
     lines = ["Success: the agent stopped within the success radius of the goal (0.15 m; "
              "0.10 m in shiraishi-house; in briggs-corridors: stopped in front of the goal "
              "landmark); % with 95% Wilson interval, episodes per cell in the second table.",

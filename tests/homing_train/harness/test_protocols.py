@@ -360,3 +360,14 @@ def test_matrix_command_rewrites_the_markdown_and_readme_block(tmp_path):
     assert (tmp_path / "m/matrix.md").read_text() == matrix_markdown(cells)
     assert "Yu & Kim, §III, Fig. 6" in (tmp_path / "m/matrix.md").read_text()
     assert "| distance |" in (tmp_path / "README.md").read_text()
+
+
+def test_a_method_that_knows_ground_truth_is_named_so_in_its_row():
+    from homing_train.harness.matrix import matrix_markdown
+    cells = [_cell("yukim", method, {"arena nest": (5, 10)})
+             for method in ("oracle", "warping", "multires")]
+    first_table = matrix_markdown(cells).split("\n\n")[1].splitlines()[2:]   # the success table
+    rows = {line.split(" |")[0][2:] for line in first_table}
+    assert rows == {"oracle (privileged: true poses and the world's map)", "warping",
+                    "multires (privileged: the taught maps' 3-D feature points and target "
+                    "poses, from the scene (map_points, map_pose))"}
