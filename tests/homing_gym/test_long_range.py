@@ -74,3 +74,23 @@ def test_a_scene_without_room_for_the_route_raises_at_reset(make_env):
     env = make_env(ENV_ID, scene=scene)
     with pytest.raises(ValueError, match="cannot hold a route"):
         env.reset(seed=0)
+
+
+def test_planned_routes_keep_their_margin_all_along_every_leg():
+    # sampled every centimetre, not only where the planner looked (every 5 cm)
+    from homing_gym.scenes import scene_factory
+    from homing_gym.scenes.base import clearances
+    from homing_gym.tasks.base import sample_free_pose
+    from homing_gym.tasks.long_range import plan_route
+
+    scene = scene_factory("lab").build(np.random.default_rng(0))
+    margin = 0.3
+    for seed in range(30):
+        rng = np.random.default_rng(seed)
+        route = plan_route(scene, sample_free_pose(scene, rng, margin), rng, 8.0, margin)
+        assert sum(math.dist(a, b) for a, b in zip(route[:-1], route[1:])) == \
+            pytest.approx(8.0)
+        for a, b in zip(route[:-1], route[1:]):
+            t = np.linspace(0.0, 1.0, max(2, math.ceil(math.dist(a, b) / 0.01) + 1))[:, None]
+            free = clearances(scene, a + t * (b - a))
+            assert free.min() >= margin - 0.01, (seed, a, b, free.min())

@@ -47,11 +47,16 @@ def test_human_render_without_a_display_is_refused_before_pybullet(monkeypatch):
 
 
 def test_landmark_navigation_takes_a_reward_mapping():
-    env = gym.make("homing_gym/LandmarkNavigation-v0", reward={"progress": 5.0},
+    # progress is the weight times the step's approach to the standing pose (metres)
+    env = gym.make("homing_gym/LandmarkNavigation-v0", reward={"progress": 5.0, "time": 0.0},
                    panorama_shape=(16, 64))
     env.reset(seed=0)
-    _, _, _, _, info = env.step(env.action_space.sample())
-    assert set(info["rewards"]) >= {"progress", "time"}
+    before = env.unwrapped.distance_to_goal
+    _, _, _, _, info = env.step(np.array([1.0, 0.0], np.float32))
+    moved = before - env.unwrapped.distance_to_goal
+    assert abs(moved) > 1e-3
+    assert info["rewards"]["progress"] == pytest.approx(5.0 * moved)
+    assert info["rewards"]["time"] == 0.0
     env.close()
 
 

@@ -226,6 +226,14 @@ def test_compare_writes_table_and_pngs(tmp_path):
     assert compare_cli.main(paths + ["--out", str(tmp_path / "cmp"), "--trajectories", "2"]) == 0
     table = (tmp_path / "cmp" / "table.md").read_text().splitlines()
     assert table[2].startswith("| oracle |") and table[3].startswith("| random |")
+    for line, path in zip(table[2:4], paths):    # each cell is its result's own value
+        s = EvalResult.load(path).summary
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        assert cells[1] == str(s["episodes"])
+        assert cells[2].startswith(f"{100 * s['success_rate']:.1f} [")
+        assert cells[3].startswith(f"{s['spl']:.3f} [")
+        assert cells[4].startswith(f"{s['soft_spl']:.3f} [")
+        assert cells[5].startswith(f"{100 * s['final_distance_mean']:.1f} [")
     for png in ("success_vs_distance.png", "final_distance.png", "trajectories.png"):
         assert (tmp_path / "cmp" / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
@@ -467,3 +475,30 @@ def test_a_ray_address_where_nothing_answers_fails_at_once():
         server.bind(("127.0.0.1", 0))
         server.listen()
         check_ray_address(f"ray://127.0.0.1:{server.getsockname()[1]}")
+
+
+def test_an_episode_that_passes_home_and_drives_on_is_measured_from_its_path():
+    # straight along y = 0.9 in the arena (clear of the cylinders): through home at
+    # x = -0.3 and on for 40 steps of 0.1 s at 0.3 m/s
+    from homing_train.harness import metrics
+    from homing_train.harness.evaluate import run_episode
+
+    class Forward:
+        def predict(self, observation, state=None, episode_start=None, deterministic=True):
+            return np.array([1.0, 0.0], np.float32), state
+
+    env = gym.make(ENV_ID, panorama_shape=(16, 64), max_episode_steps=40, success_on="stop")
+    start, home = (-0.9, 0.9, 0.0), (-0.3, 0.9, 0.0)
+    record = run_episode(env, Forward(), 0, start=start, home=home)
+    env.close()
+    path = np.asarray(record.trajectory)
+    distances = np.hypot(path[:, 0] - home[0], path[:, 1] - home[1])
+    assert record.min_distance == pytest.approx(distances.min(), abs=1e-3) and \
+        record.min_distance < 0.05
+    assert record.final_distance == pytest.approx(distances[-1], abs=1e-3)
+    assert record.final_distance > 0.3
+    assert not record.success and record.shortest_path == pytest.approx(0.6, abs=0.02)
+    # soft-SPL from where it ended, not from its closest approach
+    assert record.soft_spl == pytest.approx(metrics.soft_spl(
+        record.final_distance, record.shortest_path, record.path_length), abs=0.02)
+    assert record.soft_spl < 0.5 * record.shortest_path / record.path_length

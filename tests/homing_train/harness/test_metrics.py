@@ -160,3 +160,25 @@ def test_aggregate_of_strata_that_cannot_vary_and_bad_input():
     for bad in ([], [(3, 2)], [(0, 0)], [(-1, 4)]):
         with pytest.raises(ValueError):
             aggregate_success(bad)
+
+
+def test_every_summary_field_against_hand_computed_values():
+    from dataclasses import replace
+    base = _record(0, True, 0.4, 0.8)
+    records = [replace(base, seed=0, path_length=1.0, steps=10, collisions=0, soft_spl=0.2,
+                       min_distance=0.05, final_heading_error_deg=10.0),
+               replace(base, seed=1, success=False, path_length=2.0, steps=30, collisions=4,
+                       soft_spl=0.5, min_distance=0.40, final_heading_error_deg=50.0),
+               replace(base, seed=2, path_length=4.5, steps=50, collisions=2, soft_spl=0.8,
+                       min_distance=0.12, final_heading_error_deg=30.0)]
+    s = summarize(records, bin_width=0.3)
+    assert s["path_length_mean"] == pytest.approx(7.5 / 3)
+    assert s["steps_mean"] == pytest.approx(30.0)
+    assert s["collisions_mean"] == pytest.approx(2.0)
+    assert s["collision_free_rate"] == pytest.approx(1 / 3)
+    assert s["soft_spl"] == pytest.approx(0.5)
+    assert s["min_distance_mean"] == pytest.approx(0.19)
+    assert s["heading_error_deg_mean"] == pytest.approx(30.0)
+    assert s["heading_error_deg_median"] == pytest.approx(30.0)
+    assert s["reached_rate"] == pytest.approx(2 / 3)          # 0.05 and 0.12 <= 0.15 m
+    assert s["reached_ci"] == list(wilson_interval(2, 3))
