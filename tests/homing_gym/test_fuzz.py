@@ -3,7 +3,9 @@ bad inputs to every command, each case in its own subprocess with a timeout, mus
 a clear error.
 
 An env case makes the env, resets it and steps it; the outcome is one of ``clear`` (a
-``ValueError``/``TypeError`` or Gymnasium error naming the problem), ``accepted`` (no error:
+``ValueError``/``TypeError`` or Gymnasium error whose message names the bad argument, or
+says ``action`` for a bad action), ``vague`` (such an error that names neither),
+``accepted`` (no error:
 for a bad input, silently accepted), ``deep`` (any other exception, from deep inside
 PyBullet or numpy), ``crash`` (the process died) or ``hang`` (past the timeout). A command
 case is ``clear`` when the command exits with status 2 and says ``error:`` without a
@@ -45,6 +47,8 @@ BAD_KWARGS = [
     {"vfov_deg": 500}, {"renderer": "nope"}, {"omni_size": 3},
     {"max_episode_steps": 0}, {"max_episode_steps": 2.5}, {"odometry_origin": "goal"},
     {"drive": "tank"}, {"drive": "synchro", "action_type": "discrete"},
+    {"panorama_shape": 48}, {"sky_color": 5}, {"camera_height": "0.3"}, {"bogus": 1},
+    {"max_speed": 1e9}, {"supersampling": True}, {"obs_keys": "panorama"},
 ]
 BAD_COMMANDS = [   # (module of the command, arguments)
     ("homing_train.harness.eval_command", ["--policy", "nope", "--out", "{tmp}/r.json"]),
@@ -77,6 +81,14 @@ BAD_COMMANDS = [   # (module of the command, arguments)
     ("homing_train.learning.train", ["--hp", "n_stepz=64", "--out", "{tmp}/run"]),
     ("homing_gym.benchmark", ["--steps", "0"]),
     ("homing_gym.benchmark", ["--renderers", "nope"]),
+    ("homing_gym.benchmark", ["--steps", "10", "--json", "/proc/none/b.json"]),
+    ("homing_train.harness.eval_command", ["--policy", "random", "--seed", "-1",
+                                           "--out", "{tmp}/r.json"]),
+    ("homing_train.harness.eval_command", ["--policy", "random", "--env-kwargs",
+                                           '{"bogus": 1}', "--out", "{tmp}/r.json"]),
+    ("homing_train.harness.suite", ["--env", "nope/Nope-v0", "--out", "{tmp}/suite"]),
+    ("homing_train.harness.field", ["--policy", "warping", "--grid", "1e-6", "--no-return",
+                                    "--out", "{tmp}/f.png"]),
 ]
 BAD_ACTIONS = {"continuous": [[NAN, 0], [INF, 0], None, "forward", [1, 2, 3], [True, False],
                               {"complex": [0.5, 1]}],
@@ -100,13 +112,15 @@ try:
     env.close()
     print(json.dumps(["accepted", ""]))
 except (ValueError, TypeError, gym.error.Error) as err:
-    print(json.dumps(["clear", f"{type(err).__name__}: {err}"]))
+    names = [*case["kwargs"], *(["action"] if "action" in case else [])]
+    named = any(name.lower() in str(err).lower() for name in names)
+    print(json.dumps(["clear" if named else "vague", f"{type(err).__name__}: {err}"]))
 except Exception as err:
     print(json.dumps(["deep", f"{type(err).__name__}: {err}"]))
 """
 
 
-def cases(n_kwargs: int = 50, seed: int = 0) -> list[dict]:
+def cases(n_kwargs: int = 60, seed: int = 0) -> list[dict]:
     """A seeded sample of constructor cases over the env ids, and every bad action."""
     rng = np.random.default_rng(seed)
     out = [{"env_id": ENV_IDS[int(rng.integers(len(ENV_IDS)))],
@@ -193,7 +207,8 @@ if __name__ == "__main__":
     results = run_all()
     counts = Counter(outcome for _, outcome, _ in results)
     print(f"tried {len(results)}: " + ", ".join(f"{k} {counts.get(k, 0)}" for k in
-                                                ("clear", "accepted", "deep", "crash", "hang")))
+                                                ("clear", "vague", "accepted", "deep", "crash",
+                                                 "hang")))
     for case, outcome, message in results:
         if outcome != "clear":
             print(f"  {outcome}: {case} -> {message[:160]}")
