@@ -44,6 +44,7 @@ from homing_baselines.motion import Move
 from homing_gym.geometry import wrap_angle
 from homing_gym.panorama import bearing_column, column_bearing, signature_weights
 from homing_gym.vision import horizon_line
+from homing_gym.validation import is_real
 
 
 @dataclass(frozen=True)
@@ -187,7 +188,7 @@ class WarpingController(Controller):
     smooth_deg: float = 2.0
 
     def validate(self) -> None:
-        if not (isinstance(self.step_length, (int, float)) and math.isfinite(self.step_length)
+        if not (is_real(self.step_length)
                 and self.step_length > 0):
             raise ValueError(f"warping: step_length must be positive metres, "
                              f"got {self.step_length!r}")

@@ -41,7 +41,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-from homing_gym.validation import require_positive
+from homing_gym.validation import is_real, require_positive
 
 #: The paper's scale factor (Fig. 3, Fig. 5).
 DEFAULT_P = 2 / 3
@@ -65,7 +65,7 @@ def square_wave(x):
 
 def check_p(p: float) -> float:
     """``p`` as a float; ``ValueError`` unless ``0 < p < 1``."""
-    if not (isinstance(p, (int, float)) and math.isfinite(p) and 0 < p < 1):
+    if not (is_real(p) and 0 < p < 1):
         raise ValueError(f"the self-similarity scale p must lie in (0, 1), got {p!r}")
     return float(p)
 

@@ -17,6 +17,7 @@ from dataclasses import replace
 import numpy as np
 
 from homing_gym.scenes.base import Landmark, Scene, clearance
+from homing_gym.validation import is_real
 
 #: Free distance (m) kept between a changed object and a path or work location.
 PATH_MARGIN = 0.45
@@ -52,7 +53,7 @@ def daily_changes(scene: Scene, rng: np.random.Generator, strength: float) -> Sc
     new yaw) with probability ``strength / 2``; ``round(3 * strength)`` new small objects
     (boxes and cylinders 10-25 cm across, 10-35 cm tall) are put down at random free
     places of the rooms. 0 returns the scene unchanged."""
-    if not (isinstance(strength, (int, float)) and 0 <= strength <= 1):
+    if not (is_real(strength) and 0 <= strength <= 1):
         raise ValueError(f"daily change strength must be in [0, 1], got {strength!r}")
     if strength == 0:
         return scene

@@ -31,6 +31,7 @@ import numpy as np
 from homing_gym.scenes.base import HEIGHT_BAND, Color, Scene
 from homing_gym.scenes.footprint import band_triangles
 from homing_gym.scenes.mesh_part import MeshPart
+from homing_gym.validation import is_real
 
 UP_AXES = ("z", "y")
 #: Default colour (RGB) of faces a file gives no colour.
@@ -64,7 +65,7 @@ SPEC_OPTIONS = {
 
 def _placement(scale: float, up: str, offset) -> np.ndarray:
     """4 x 4 transform: scale, then turn ``up`` onto +z, then shift by ``offset``."""
-    if not (isinstance(scale, (int, float)) and math.isfinite(scale) and scale > 0):
+    if not (is_real(scale) and scale > 0):
         raise ValueError(f"scale must be a positive number, got {scale!r}")
     if up not in UP_AXES:
         raise ValueError(f"unknown up axis {up!r}; allowed: {UP_AXES}")

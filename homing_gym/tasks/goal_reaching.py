@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, fields
 
 from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.base import Task
-from homing_gym.validation import require_positive
+from homing_gym.validation import is_real, require_positive
 
 
 SUCCESS_MODES = ("reach", "stop")
@@ -35,7 +34,7 @@ class RewardConfig:
     def __post_init__(self) -> None:
         for f in fields(self):
             value = getattr(self, f.name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value)):
+            if not is_real(value):
                 raise ValueError(f"reward weight {f.name} must be a finite number, got {value!r}")
 
     @classmethod

@@ -24,7 +24,7 @@ from homing_gym.scenes.base import Scene, clearance
 from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.base import Episode, sample_free_pose
 from homing_gym.tasks.goal_reaching import GoalReachingTask, RewardConfig
-from homing_gym.validation import require_positive
+from homing_gym.validation import is_real, require_positive
 
 
 OUTBOUND, HOMING = 0, 1
@@ -89,7 +89,7 @@ class LongRangeHomingTask(GoalReachingTask):
                  outbound_yaw_rate: float = 0.5, success_radius: float = 0.2,
                  success_on: str = "reach", reward: RewardConfig = RewardConfig(),
                  clearance_margin: float = 0.3):
-        if not (isinstance(route_length, (int, float)) and 0.5 <= route_length <= 30):
+        if not (is_real(route_length) and 0.5 <= route_length <= 30):
             raise ValueError(f"route_length must be in [0.5, 30] metres, got {route_length!r}")
         require_positive("outbound_speed", outbound_speed, "m/s")
         require_positive("outbound_yaw_rate", outbound_yaw_rate, "rad/s")
