@@ -94,7 +94,8 @@ def test_import_finds_a_module_in_the_current_folder(tmp_path, monkeypatch):
     (tmp_path / "my_world_here.py").write_text("LOADED = True\n")
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr(sys, "path", [p for p in sys.path if p not in ("", str(tmp_path))])
-    monkeypatch.delenv("HOMING_GYM_IMPORT", raising=False)
+    monkeypatch.setenv("HOMING_GYM_IMPORT", "")     # restored after: later subprocesses
+    monkeypatch.setattr(sys, "modules", dict(sys.modules))   # must not import it
     import_user_module("my_world_here")
     assert sys.modules["my_world_here"].LOADED
     assert sys.path[-1] == str(tmp_path)                   # searched last: shadows nothing
