@@ -189,11 +189,17 @@ class AlignedBandExtractor(BaseFeaturesExtractor):
 
     def column_features(self, image: torch.Tensor) -> torch.Tensor:
         """Unit-length per-column features ``(N, K, W)`` of standardised ``(N, C, H, W)``
-        images."""
+        images (standard deviation with Bessel's correction). Written with plain sums:
+        torch's ``std`` and ``F.normalize`` took 10x longer on these small tensors on a CPU,
+        a third of a rollout's inference."""
         flat = image.flatten(1, 2)
+        values = flat[0].numel()
         mean = flat.mean(dim=(1, 2), keepdim=True)
-        std = flat.std(dim=(1, 2), keepdim=True)
-        return F.normalize(self.encoder((flat - mean) / (std + 1e-3)), dim=1)
+        centred = flat - mean
+        std = (centred.square().sum(dim=(1, 2), keepdim=True) / (values - 1)).sqrt()
+        features = self.encoder(centred / (std + 1e-3))
+        norm = features.square().sum(dim=1, keepdim=True).sqrt().clamp_min(1e-12)
+        return features / norm
 
     def shift_weights(self, f: torch.Tensor, g: torch.Tensor) -> torch.Tensor:
         """``p(s)``, ``(N, W)``: softmax over shifts ``s`` (columns, counter-clockwise
@@ -206,7 +212,8 @@ class AlignedBandExtractor(BaseFeaturesExtractor):
 
     def forward(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
         current, goal = (observations[k] for k in self.image_keys)
-        f, g = self.column_features(current), self.column_features(goal)
+        # both images through the encoder in one batch: half the calls, the same values
+        f, g = self.column_features(torch.cat([current, goal])).chunk(2)
         p = self.shift_weights(f, g)
         width = f.shape[-1]
         aligned = torch.fft.irfft(torch.fft.rfft(g, dim=-1)

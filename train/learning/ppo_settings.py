@@ -82,6 +82,46 @@ def _layers(value: Any) -> bool:
     return isinstance(value, list) and all(_integer(x, 1) for x in value)
 
 
+def _convolutions(value: Any) -> bool:
+    return isinstance(value, (list, tuple)) and len(value) >= 1 and all(
+        isinstance(layer, (list, tuple)) and len(layer) == 3
+        and all(_integer(x, 1) for x in layer) for layer in value)
+
+
+_CONVOLUTIONS = ("a non-empty list of [channels, kernel, stride] layers of integers >= 1, "
+                 "e.g. [[16, 5, 1], [16, 5, 1]]")
+#: extractor -> its keyword arguments a run may set (``extractor_kwargs``; ``features_dim``
+#: is a setting of its own) -> (test of the value, what is allowed).
+EXTRACTOR_RULES: dict[str, dict[str, tuple[Callable[[Any], bool], str]]] = {
+    "panorama": {"layers": (_convolutions, _CONVOLUTIONS)},
+    "band": {"layers": (_convolutions, _CONVOLUTIONS)},
+    "align": {"encoder": (lambda v: _convolutions(v) and all(s == 1 for _, _, s in v),
+                          _CONVOLUTIONS + " with strides 1 (one column per shift)"),
+              "head": (_convolutions, _CONVOLUTIONS),
+              "temperature": (lambda v: _number(v) and v > 0, "a positive number")},
+    "combined": {},
+}
+
+
+def extractor_arguments(extractor: str, kwargs: Any) -> dict[str, Any]:
+    """``kwargs`` (``extractor_kwargs`` of a run) checked against :data:`EXTRACTOR_RULES`
+    and made into the extractor's arguments (layer lists become tuples); raises
+    ``ValueError`` naming every unknown key and bad value."""
+    rules = EXTRACTOR_RULES[extractor]
+    if not isinstance(kwargs, dict):
+        raise ValueError(f"extractor_kwargs must be a mapping of {list(rules)} (the "
+                         f"{extractor!r} extractor's settings), got {kwargs!r}")
+    unknown = sorted(set(kwargs) - set(rules))
+    bad = [f"unknown extractor_kwargs {unknown} for the {extractor!r} extractor; allowed: "
+           f"{list(rules)}"] if unknown else []
+    bad += [f"extractor_kwargs.{key} must be {rule}, got {kwargs[key]!r}"
+            for key, (ok, rule) in rules.items() if key in kwargs and not ok(kwargs[key])]
+    if bad:
+        raise ValueError("; ".join(bad))
+    return {key: tuple(tuple(layer) for layer in value) if isinstance(value, (list, tuple))
+            else float(value) for key, value in kwargs.items()}
+
+
 def check_ppo(ppo: dict[str, Any], n_envs: int) -> None:
     """Raise ``ValueError`` naming every unknown key and bad value of ``ppo`` (and a
     ``batch_size`` larger than one rollout, ``n_steps * n_envs``)."""

@@ -46,7 +46,8 @@ from homing_train.learning import EXTRACTORS
 from homing_train.learning.curriculum import (HOOK, CurriculumSettings, last_stage, mark_stages,
                                               plot_training_success)
 from homing_train.learning.imitation import dagger
-from homing_train.learning.ppo_settings import PPO_KEYS, check_device, check_ppo, ppo_arguments
+from homing_train.learning.ppo_settings import (PPO_KEYS, check_device, check_ppo,
+                                               extractor_arguments, ppo_arguments)
 from homing_train.learning.pretrain import pretrain
 
 HYPERPARAMS = Path(str(resources.files("homing_train.learning") / "hyperparams" / "ppo.yml"))
@@ -105,6 +106,7 @@ class TrainConfig:
     torch_threads: int = 1
     extractor: str = "panorama"
     features_dim: int = 256
+    extractor_kwargs: dict = field(default_factory=dict)
     env_kwargs: dict = field(default_factory=dict)
     eval_freq: int = 10_000
     eval_episodes: int = 20
@@ -154,6 +156,7 @@ class TrainConfig:
             raise ValueError(f"eval_deterministic must be true or false, got "
                              f"{self.eval_deterministic!r}")
         check_ppo(self.ppo, self.n_envs)
+        extractor_arguments(self.extractor, self.extractor_kwargs)
         check_device(self.device)
         if self.curriculum is not None:
             CurriculumSettings.from_value(self.curriculum)
@@ -480,7 +483,8 @@ def new_model(config: TrainConfig, env, **kwargs):
 
     from homing_train.learning.extractor import policy_kwargs_for
 
-    extractor_kwargs = ({"features_dim": config.features_dim}
+    extractor_kwargs = ({"features_dim": config.features_dim,
+                         **extractor_arguments(config.extractor, config.extractor_kwargs)}
                         if config.extractor != "combined" else {})
     if config.ppo.get("use_sde") and not isinstance(env.action_space, gym.spaces.Box):
         raise ValueError(f"use_sde needs continuous actions (action_type='continuous'); "

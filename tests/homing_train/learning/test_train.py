@@ -1,6 +1,7 @@
 """homing-train: smoke runs with both extractors, save/load round trip, --resume."""
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -207,6 +208,58 @@ def test_aligned_extractor_rotates_the_goal_into_the_current_frame():
         AlignedBandExtractor(space, encoder=((8, 5, 2),))
     with pytest.raises(ValueError, match="goal"):
         AlignedBandExtractor(gym.spaces.Dict({"panorama": space["panorama"]}))
+
+
+def test_aligned_extractor_column_features_are_standardised_unit_columns():
+    """The sums in ``column_features`` compute what its docstring defines (torch's own
+    ``std`` and ``F.normalize``, which the shipped policies were trained with)."""
+    import gymnasium as gym
+    from torch.nn import functional as F
+
+    torch.manual_seed(1)
+    space = gym.spaces.Dict({k: gym.spaces.Box(0, 255, (3, 8, 64), np.uint8)
+                             for k in ("panorama", "goal")})
+    extractor = AlignedBandExtractor(space, features_dim=16)
+    image = torch.rand(5, 3, 8, 64) * torch.rand(5, 1, 1, 1)     # a different contrast each
+    flat = image.flatten(1, 2)
+    standard = (flat - flat.mean(dim=(1, 2), keepdim=True)) / (
+        flat.std(dim=(1, 2), keepdim=True) + 1e-3)
+    expected = F.normalize(extractor.encoder(standard), dim=1)
+    assert torch.allclose(extractor.column_features(image), expected, atol=1e-5)
+    # one batch through the encoder for both images: the same as one image at a time
+    obs = {"panorama": torch.rand(2, 3, 8, 64), "goal": torch.rand(2, 3, 8, 64)}
+    both = extractor(obs)
+    one = torch.cat([extractor({k: v[i:i + 1] for k, v in obs.items()}) for i in range(2)])
+    assert torch.allclose(both, one, atol=1e-5)
+
+
+def test_extractor_kwargs_size_the_network_and_bad_ones_are_named():
+    import gymnasium as gym
+
+    from homing_train.learning.ppo_settings import extractor_arguments
+
+    kwargs = extractor_arguments("align", {"encoder": [[8, 3, 1]], "head": [[16, 5, 2]],
+                                           "temperature": 10})
+    assert kwargs == {"encoder": ((8, 3, 1),), "head": ((16, 5, 2),), "temperature": 10.0}
+    space = gym.spaces.Dict({k: gym.spaces.Box(0, 255, (3, 8, 64), np.uint8)
+                             for k in ("panorama", "goal")})
+    extractor = AlignedBandExtractor(space, features_dim=16, **kwargs)
+    assert [m.conv.out_channels for m in extractor.encoder] == [8]
+    assert extractor.head[0][0].conv.out_channels == 16
+    for extractor_name, bad, named in [
+            ("align", {"layers": [[8, 3, 1]]}, "unknown extractor_kwargs ['layers']"),
+            ("align", {"encoder": [[8, 3, 2]]}, "extractor_kwargs.encoder"),
+            ("align", {"head": [[8, 0, 1]]}, "extractor_kwargs.head"),
+            ("align", {"head": []}, "extractor_kwargs.head"),
+            ("align", {"temperature": "hot"}, "extractor_kwargs.temperature"),
+            ("band", {"layers": [[8, 3]]}, "extractor_kwargs.layers"),
+            ("combined", {"layers": [[8, 3, 1]]}, "unknown extractor_kwargs"),
+            ("panorama", [[8, 3, 1]], "extractor_kwargs must be a mapping")]:
+        with pytest.raises(ValueError, match=re.escape(named)):
+            extractor_arguments(extractor_name, bad)
+    with pytest.raises(ValueError, match="extractor_kwargs.encoder"):
+        make_config("homing_gym/LocalHoming-v0", {"extractor": "align",
+                                                  "extractor_kwargs": {"encoder": [[8, 3, 2]]}})
 
 
 def test_suite_evaluates_and_compares_methods_on_one_suite(tmp_path, capsys):
