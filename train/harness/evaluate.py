@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import csv
 import dataclasses
+import inspect
 import json
 import math
 import multiprocessing as mp
@@ -387,6 +388,37 @@ def check_env_id(env_id: str) -> None:
         raise ValueError(f"unknown env id {env_id!r}; homing-gym ids: {list(homing_gym.ENV_IDS)}")
 
 
+def env_parameters(env_id: str) -> frozenset[str] | None:
+    """The keyword arguments the entry point of ``env_id`` names, or ``None`` when it
+    takes any (``**kwargs``, as homing-gym's envs do, which check the names themselves)."""
+    entry = gym.spec(env_id).entry_point
+    creator = gym.envs.registration.load_env_creator(entry) if isinstance(entry, str) else entry
+    try:
+        parameters = inspect.signature(creator).parameters.values()
+    except (TypeError, ValueError):             # a builtin or C callable: cannot tell
+        return None
+    if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in parameters):
+        return None
+    return frozenset(p.name for p in parameters
+                     if p.kind in (inspect.Parameter.POSITIONAL_OR_KEYWORD,
+                                   inspect.Parameter.KEYWORD_ONLY))
+
+
+def harness_env_kwargs(env_id: str, env_kwargs: dict[str, Any],
+                       added: dict[str, Any]) -> dict[str, Any]:
+    """``env_kwargs`` with the harness's ``added`` defaults (e.g. the renderer, recorded
+    explicitly) where the env takes them; ``ValueError`` naming every given argument that
+    the env of ``env_id`` (e.g. a user's, ``--import``) does not take."""
+    takes = env_parameters(env_id)
+    if takes is None:
+        return {**added, **env_kwargs}
+    odd = sorted(set(env_kwargs) - takes)
+    if odd:
+        raise ValueError(f"env {env_id!r} does not take the arguments {odd}; it takes "
+                         f"{sorted(takes - {'render_mode'})}")
+    return {**{k: v for k, v in added.items() if k in takes}, **env_kwargs}
+
+
 def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int = 0,
              env_kwargs: dict[str, Any] | None = None, workers: int = 1,
              params: dict[str, Any] | None = None, bin_width: float = 0.3,
@@ -425,10 +457,11 @@ def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int =
         recorded = recorded_settings(spec.source)
         env_kwargs = {**recorded.env_kwargs, **env_kwargs}
         spec = dataclasses.replace(spec, params={**recorded.params, **spec.params})
-    if spec.kind == "controller" and "obs_keys" not in env_kwargs:
+    added = simulation_settings(env_kwargs)                 # recorded explicitly
+    if spec.kind == "controller":
         # what the controller reads; observation keys never change the episodes
-        env_kwargs["obs_keys"] = list(spec.build().observation_keys())
-    env_kwargs = {**simulation_settings(env_kwargs), **env_kwargs}   # recorded explicitly
+        added["obs_keys"] = list(spec.build().observation_keys())
+    env_kwargs = harness_env_kwargs(env_id, env_kwargs, added)
     settings = json.loads(json.dumps({"policy": spec.label, "params": spec.resolved_params(),
                                       "env_id": env_id, "env_kwargs": env_kwargs,
                                       **({"tasks": tasks} if tasks is not None else {})},

@@ -184,6 +184,10 @@ class AlignedBandExtractor(BaseFeaturesExtractor):
         with torch.no_grad():
             n_flat = self.head(torch.zeros(1, 3 * encoder[-1][0], width)).shape[1]
         self.log_temperature = nn.Parameter(torch.tensor(float(temperature)).log())
+        # random weights that hash an image to one number (not learned, not saved)
+        self.register_buffer("hash_weights", torch.rand(
+            channels * rows * width, generator=torch.Generator().manual_seed(0)),
+            persistent=False)
         self.linear = nn.Sequential(nn.Linear(n_flat + width, features_dim),
                                     nn.LayerNorm(features_dim))
 
@@ -201,6 +205,25 @@ class AlignedBandExtractor(BaseFeaturesExtractor):
         norm = features.square().sum(dim=1, keepdim=True).sqrt().clamp_min(1e-12)
         return features / norm
 
+    def distinct_images(self, images: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor | None]:
+        """``(distinct, inverse)`` with ``images == distinct[inverse]``: each image once.
+        A PPO minibatch holds many samples of one episode, all with the same goal, so the
+        goals are encoded once each. Found by hashing each image to one number and then
+        checked exactly; ``inverse`` is ``None`` (use ``images`` as they are) when two
+        different images share a hash or nothing repeats."""
+        flat = images.flatten(1)
+        _, inverse = torch.unique(flat @ self.hash_weights, return_inverse=True)
+        if int(inverse.max()) + 1 == len(images):
+            return images, None
+        first = torch.empty(int(inverse.max()) + 1, dtype=torch.long,
+                            device=images.device).scatter_(0, inverse,
+                                                           torch.arange(len(images),
+                                                                        device=images.device))
+        distinct = images[first]
+        if not torch.equal(distinct[inverse], images):
+            return images, None
+        return distinct, inverse
+
     def shift_weights(self, f: torch.Tensor, g: torch.Tensor) -> torch.Tensor:
         """``p(s)``, ``(N, W)``: softmax over shifts ``s`` (columns, counter-clockwise
         as the panorama's columns run) of the correlation ``mean_theta <f(theta),
@@ -212,8 +235,14 @@ class AlignedBandExtractor(BaseFeaturesExtractor):
 
     def forward(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
         current, goal = (observations[k] for k in self.image_keys)
+        # in training, each distinct goal once (the same values, less backpropagation);
         # both images through the encoder in one batch: half the calls, the same values
-        f, g = self.column_features(torch.cat([current, goal])).chunk(2)
+        goals, inverse = (self.distinct_images(goal) if torch.is_grad_enabled()
+                          else (goal, None))
+        features = self.column_features(torch.cat([current, goals]))
+        f, g = features[:len(current)], features[len(current):]
+        if inverse is not None:
+            g = g[inverse]
         p = self.shift_weights(f, g)
         width = f.shape[-1]
         aligned = torch.fft.irfft(torch.fft.rfft(g, dim=-1)

@@ -65,7 +65,10 @@ def _rollout_timer():
 def measure(env, model, steps: int, label: str) -> Throughput:
     """Measure a vectorised ``env`` and a PPO ``model`` built on it (as ``homing-train``
     builds them) over ``steps`` env steps, each of the three parts; closes nothing."""
+    import torch
     from stable_baselines3.common.logger import Logger
+
+    from homing_train.learning.thread_split import phase_threads
 
     n_envs = env.num_envs
     rounds = max(steps // n_envs, 1)
@@ -83,7 +86,8 @@ def measure(env, model, steps: int, label: str) -> Throughput:
     model.set_logger(Logger(None, []))       # SB3's default makes a folder in /tmp per run
     timer = _rollout_timer()
     t0 = time.perf_counter()
-    model.learn(steps, callback=timer, progress_bar=False)
+    model.learn(steps, callback=[timer, phase_threads(torch.get_num_threads())],
+                progress_bar=False)
     total = time.perf_counter() - t0
     return Throughput(label, n_envs, env_rate, inference, model.num_timesteps / total,
                       timer.rollout_s, total - timer.rollout_s)

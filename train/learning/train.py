@@ -46,6 +46,7 @@ from homing_train.learning import EXTRACTORS
 from homing_train.learning.curriculum import (HOOK, CurriculumSettings, last_stage, mark_stages,
                                               plot_training_success)
 from homing_train.learning.imitation import dagger
+from homing_train.learning.thread_split import phase_threads
 from homing_train.learning.ppo_settings import (PPO_KEYS, check_device, check_ppo,
                                                extractor_arguments, ppo_arguments)
 from homing_train.learning.pretrain import pretrain
@@ -560,7 +561,7 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
             _restore_evaluations(eval_cb, out)
         ckpt_cb = CheckpointCallback(max(config.checkpoint_freq // config.n_envs, 1),
                                      str(out / "checkpoints"), name_prefix="ppo")
-        callbacks = [eval_cb, ckpt_cb]
+        callbacks = [eval_cb, ckpt_cb, phase_threads(config.torch_threads)]
         if curriculum is not None:     # a resumed run goes on at the stage it had reached
             stage, history = (last_stage(out / "curriculum.json") if checkpoint is not None
                               else (0, []))

@@ -502,3 +502,31 @@ def test_an_episode_that_passes_home_and_drives_on_is_measured_from_its_path():
     assert record.soft_spl == pytest.approx(metrics.soft_spl(
         record.final_distance, record.shortest_path, record.path_length), abs=0.02)
     assert record.soft_spl < 0.5 * record.shortest_path / record.path_length
+
+
+def test_harness_passes_its_defaults_only_to_envs_that_take_them():
+    """A user's env whose constructor names its arguments gets the harness's recorded
+    settings only where it takes them, and a given argument it does not take is an
+    error naming it (not a TypeError from deep inside gym.make)."""
+    from homing_gym.envs import LocalHomingEnv
+    from homing_train.harness.evaluate import env_parameters, harness_env_kwargs
+
+    class FixedEnv(LocalHomingEnv):
+        def __init__(self, render_mode=None, renderer="tiny", size=1.0):
+            super().__init__(render_mode=render_mode, renderer=renderer)
+
+    gym.register("test_harness/FixedEnv-v0", entry_point=FixedEnv)
+    try:
+        assert env_parameters("test_harness/FixedEnv-v0") == {"render_mode", "renderer", "size"}
+        added = {"renderer": "raycast", "physics_substeps": 12, "obs_keys": ["panorama"]}
+        assert harness_env_kwargs("test_harness/FixedEnv-v0", {"size": 2.0}, added) == {
+            "renderer": "raycast", "size": 2.0}
+        with pytest.raises(ValueError, match=r"does not take the arguments \['bogus'\]; "
+                                             r"it takes \['renderer', 'size'\]"):
+            harness_env_kwargs("test_harness/FixedEnv-v0", {"bogus": 1}, added)
+    finally:
+        gym.registry.pop("test_harness/FixedEnv-v0")
+    # homing-gym's own envs take any name and check it themselves: everything is passed
+    assert env_parameters("homing_gym/LocalHoming-v0") is None
+    assert harness_env_kwargs("homing_gym/LocalHoming-v0", {"scene": "lab"}, added) == {
+        **added, "scene": "lab"}

@@ -233,6 +233,42 @@ def test_aligned_extractor_column_features_are_standardised_unit_columns():
     assert torch.allclose(both, one, atol=1e-5)
 
 
+def test_aligned_extractor_encodes_each_distinct_goal_once_with_the_same_result():
+    import gymnasium as gym
+
+    torch.manual_seed(2)
+    space = gym.spaces.Dict({k: gym.spaces.Box(0, 255, (3, 8, 64), np.uint8)
+                             for k in ("panorama", "goal")})
+    extractor = AlignedBandExtractor(space, features_dim=16)
+    goals = torch.rand(3, 3, 8, 64)
+    which = torch.tensor([2, 0, 2, 2, 1, 0])
+    batch = goals[which]
+    distinct, inverse = extractor.distinct_images(batch)
+    assert len(distinct) == 3 and torch.equal(distinct[inverse], batch)
+    assert extractor.distinct_images(goals)[1] is None          # nothing repeats
+    # one pixel apart is another goal
+    close = batch.clone()
+    close[3, 0, 0, 0] += 1 / 255
+    assert len(extractor.distinct_images(close)[0]) == 4
+    # a hash shared by two different images: every image encoded, nothing merged
+    extractor.hash_weights.zero_()
+    assert extractor.distinct_images(close)[1] is None
+    extractor.hash_weights.copy_(torch.rand_like(extractor.hash_weights))
+    # training (gradients on) gives the values and gradients of inference, image by image
+    obs = {"panorama": torch.rand(6, 3, 8, 64), "goal": batch}
+    out = extractor(obs)
+    out.square().sum().backward()
+    grads = [p.grad.clone() for p in extractor.parameters()]
+    extractor.zero_grad()
+    with torch.no_grad():
+        plain = extractor(obs)
+    assert torch.allclose(out, plain, atol=1e-5)
+    whole = torch.cat([extractor({k: v[i:i + 1] for k, v in obs.items()}) for i in range(6)])
+    whole.square().sum().backward()
+    for got, want in zip(grads, (p.grad for p in extractor.parameters())):
+        assert torch.allclose(got, want, rtol=1e-4, atol=1e-5)
+
+
 def test_extractor_kwargs_size_the_network_and_bad_ones_are_named():
     import gymnasium as gym
 
@@ -536,3 +572,17 @@ def test_a_list_of_scenes_gives_each_env_its_own_and_bad_lists_are_refused():
         TrainConfig("homing_gym/LocalHoming-v0", pretrain_samples=10, env_kwargs=both)
     TrainConfig("homing_gym/LocalHoming-v0", pretrain_samples=10, pretrain_scenes=2,
                 env_kwargs=both)
+
+
+def test_phase_threads_run_rollouts_on_one_thread_and_updates_on_the_settings():
+    from homing_train.learning.thread_split import phase_threads
+
+    before = torch.get_num_threads()
+    try:
+        callback = phase_threads(2)
+        callback.on_rollout_start()
+        assert torch.get_num_threads() == 1
+        callback.on_rollout_end()
+        assert torch.get_num_threads() == 2
+    finally:
+        torch.set_num_threads(before)
