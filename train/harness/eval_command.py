@@ -35,6 +35,9 @@ def _protocol_cell(args) -> int:
                          "parameters; drop --env/--env-kwargs/--seed/--param")
     chosen = protocol(args.protocol)
     folder = Path(os.path.splitext(args.out)[0])
+    if folder == Path(args.out):        # the cell's file and its settings' folder would clash
+        raise ValueError(f"--out {args.out!r} needs an extension with --protocol, e.g. "
+                         f"{args.out}.json: the settings' results go to the folder {args.out}/")
     cell = run_cell(chosen, args.policy, folder, args.episodes, args.workers,
                     progress=not args.quiet, resume=args.resume, backend=args.backend,
                     address=args.ray_address)

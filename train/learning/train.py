@@ -644,7 +644,11 @@ def _benchmark(parser, config: TrainConfig, steps: int) -> int:
         env = make_vec(config, config.n_envs, config.seed)
         try:
             env.action_space.seed(config.seed)
-            print(table([measure(env, new_model(config, env), steps, label)]))
+            model = new_model(config, env)
+            if config.init_policy:      # a trained policy's episodes, not a random one's
+                load_policy_weights(model, config.init_policy)
+                label += f", from {Path(config.init_policy).name}"
+            print(table([measure(env, model, steps, label)]))
         finally:
             env.close()
     except (ValueError, EnvWorkerError) as err:
@@ -674,7 +678,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="measure this configuration's throughput over STEPS env steps "
                              "(env alone, inference, PPO end to end and its rollout/update "
                              "split; default 4096) and print it; trains nothing, writes "
-                             "nothing")
+                             "nothing. With --hp init_policy=ZIP, PPO starts from that "
+                             "network (a trained policy's episodes: longer, fewer resets)")
     args = parser.parse_args(argv)
     try:
         require_extra("train", "homing-train")

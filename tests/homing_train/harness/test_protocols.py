@@ -180,6 +180,14 @@ def test_protocol_mode_refuses_settings_the_protocol_fixes(tmp_path, capsys):
     with pytest.raises(SystemExit):
         eval_command.main(["--protocol", "yukim", "--policy", "selfsimilar_nope",
                            "--out", str(tmp_path / "x.json")])
+    capsys.readouterr()
+    # an --out without extension would be both the cell's file and its settings' folder:
+    # refused before any episode runs, nothing written
+    with pytest.raises(SystemExit) as exit_:
+        eval_command.main(["--protocol", "yukim", "--policy", "oracle",
+                           "--out", str(tmp_path / "cell")])
+    assert exit_.value.code == 2 and "needs an extension" in capsys.readouterr().err
+    assert not (tmp_path / "cell").exists()
 
 
 def test_matrix_files_name_every_cell_with_its_command(tmp_path):

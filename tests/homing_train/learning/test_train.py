@@ -548,6 +548,22 @@ def test_benchmark_measures_the_ppo_time_split_and_writes_nothing(tmp_path, caps
     assert list(tmp_path.iterdir()) == []
     with pytest.raises(SystemExit):
         main(["--benchmark", "10", "--hp", "n_steps=64"])     # less than one rollout
+    # from a trained network of the same layout: its episodes, named in the row
+    from homing_train.learning.train import make_vec, new_model
+
+    config = make_config("homing_gym/LocalHoming-v0", {
+        "n_envs": 1, "vec": "dummy", "n_steps": 64, "batch_size": 32, "n_epochs": 1,
+        "env_kwargs": {"scene": "arena", "panorama_shape": [16, 64]}})
+    env = make_vec(config, 1, 0)
+    new_model(config, env).save(tmp_path.parent / "trained.zip")
+    env.close()
+    assert main(args + ["--hp", f"init_policy={tmp_path.parent / 'trained.zip'}"]) == 0
+    rows = [line for line in capsys.readouterr().out.splitlines() if line.startswith("| Local")]
+    assert len(rows) == 1 and "from trained.zip" in rows[0]
+    with pytest.raises(SystemExit):           # another layout: refused with its reason
+        main(args + ["--hp", "features_dim=8",
+                     "--hp", f"init_policy={tmp_path.parent / 'trained.zip'}"])
+    assert "does not fit" in capsys.readouterr().err
 
 
 def test_a_list_of_scenes_gives_each_env_its_own_and_bad_lists_are_refused():
