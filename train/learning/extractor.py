@@ -212,13 +212,12 @@ class AlignedBandExtractor(BaseFeaturesExtractor):
         checked exactly; ``inverse`` is ``None`` (use ``images`` as they are) when two
         different images share a hash or nothing repeats."""
         flat = images.flatten(1)
-        _, inverse = torch.unique(flat @ self.hash_weights, return_inverse=True)
-        if int(inverse.max()) + 1 == len(images):
+        keys, inverse = torch.unique(flat @ self.hash_weights, return_inverse=True)
+        if len(keys) == len(images):
             return images, None
-        first = torch.empty(int(inverse.max()) + 1, dtype=torch.long,
-                            device=images.device).scatter_(0, inverse,
-                                                           torch.arange(len(images),
-                                                                        device=images.device))
+        rows = torch.arange(len(images), device=images.device)
+        first = torch.empty(len(keys), dtype=torch.long,
+                            device=images.device).scatter_(0, inverse, rows)
         distinct = images[first]
         if not torch.equal(distinct[inverse], images):
             return images, None
