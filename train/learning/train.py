@@ -2,10 +2,12 @@
 
     homing-train --env homing_gym/LocalHoming-v0 --seed 0 --timesteps 300000 --out runs/ppo
     homing-train --resume runs/ppo          # continue from the last checkpoint
+    homing-train --recipe ppo_procedural_fast --seed 1 --out runs/fast_s1   # a shipped recipe
 
 Hyperparameters come from ``train/learning/hyperparams/ppo.yml`` (keyed by env id, with a
-``default`` entry), then ``--hyperparams FILE``, then ``--hp KEY=VALUE`` (values parsed as
-YAML), then the dedicated flags. A run folder holds ``model.zip`` (final),
+``default`` entry), or ``--hyperparams FILE``, or ``--recipe NAME`` (the settings a shipped
+policy was trained with, recorded in its ``.yml``), then ``--hp KEY=VALUE`` (values parsed
+as YAML), then the dedicated flags. A run folder holds ``model.zip`` (final),
 ``best_model.zip`` and ``evaluations.npz`` (``EvalCallback`` on held-out seeds, with
 success rates), ``checkpoints/``, ``config.yml``, ``command.txt``, ``versions.json``,
 ``summary.json`` (timesteps, wall time, env steps per second of ``learn()``),
@@ -51,6 +53,7 @@ from homing_train.learning.ppo_settings import (PPO_KEYS, check_device, check_pp
                                                extractor_arguments, ppo_arguments)
 from homing_train.learning.pretrain import pretrain
 
+DEFAULT_ENV = "homing_gym/LocalHoming-v0"
 HYPERPARAMS = Path(str(resources.files("homing_train.learning") / "hyperparams" / "ppo.yml"))
 EVAL_SEED_OFFSET = 1_000_000
 IMITATION_SEED_OFFSET = 2_000_000
@@ -205,6 +208,25 @@ def load_hyperparams(env_id: str, path: Path = HYPERPARAMS) -> dict[str, Any]:
     merged = dict(table.get("default") or {})
     merged.update(table.get(env_id) or {})
     return merged
+
+
+def recipe(name: str, folder: Path | None = None) -> tuple[str, dict[str, Any]]:
+    """The env id and the settings (as :func:`make_config` takes them: PPO's keys at the top
+    level) that the shipped policy ``name`` was trained with: the ``config`` recorded in
+    ``train/shipped/NAME.yml`` (``folder``: another folder of shipped policies)."""
+    from homing_train.harness.policies import POLICY_DIR
+
+    folder = POLICY_DIR if folder is None else folder
+    recorded = {p.stem: p for p in sorted(folder.glob("*.yml"))}
+    if name not in recorded:
+        raise ValueError(f"unknown recipe {name!r}; allowed (shipped policies): "
+                         f"{sorted(recorded)}")
+    config = (yaml.safe_load(recorded[name].read_text()) or {}).get("config")
+    if not isinstance(config, dict) or "env_id" not in config:
+        raise ValueError(f"{recorded[name]} records no training config (no 'config' with an "
+                         f"'env_id'); its recipe cannot be rerun")
+    settings = {k: v for k, v in config.items() if k not in ("env_id", "ppo")}
+    return config["env_id"], {**settings, **(config.get("ppo") or {})}
 
 
 def parse_overrides(items: list[str]) -> dict[str, Any]:
@@ -656,14 +678,34 @@ def _benchmark(parser, config: TrainConfig, steps: int) -> int:
     return 0
 
 
+def starting_settings(parser, args) -> tuple[str, dict[str, Any]]:
+    """The env id and settings ``--hp`` and the flags start from: ``--recipe``'s, else the
+    hyperparameter file's for ``--env``."""
+    if args.recipe is None:
+        env_id = args.env or DEFAULT_ENV
+        return env_id, load_hyperparams(env_id, args.hyperparams)
+    if args.hyperparams != HYPERPARAMS:
+        parser.error("--recipe and --hyperparams both give the starting settings: use one")
+    env_id, settings = recipe(args.recipe)
+    if args.env not in (None, env_id):
+        raise ValueError(f"--recipe {args.recipe} trains {env_id}, not --env {args.env}")
+    return env_id, settings
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = command_parser("homing-train", __doc__)
-    parser.add_argument("--env", default="homing_gym/LocalHoming-v0")
+    parser.add_argument("--env", help="env id (default homing_gym/LocalHoming-v0, or the "
+                        "recipe's)")
     parser.add_argument("--out", help="run folder (default runs/<env>_<extractor>_s<seed>)")
     parser.add_argument("--resume", metavar="RUN", help="continue the run in this folder "
                         "from its last checkpoint, with its saved config")
     parser.add_argument("--hyperparams", type=Path, default=HYPERPARAMS,
                         help="YAML file keyed by env id")
+    parser.add_argument("--recipe", metavar="NAME",
+                        help="start from the settings the shipped policy NAME was trained "
+                             "with (its env, envs, network, PPO settings, curriculum), "
+                             "e.g. ppo_procedural_fast, the default learned policy; --hp "
+                             "and the flags override them")
     parser.add_argument("--hp", action="append", default=[], metavar="KEY=VALUE",
                         help="override a hyperparameter (YAML value); repeatable")
     parser.add_argument("--env-kwargs", type=json.loads, help="JSON kwargs of gym.make")
@@ -685,6 +727,9 @@ def main(argv: list[str] | None = None) -> int:
         require_extra("train", "homing-train")
     except MissingExtraError as err:
         parser.exit(2, f"homing-train: error: {err}\n")
+    if args.resume and args.recipe:
+        parser.error("--resume continues a run with its saved config; --recipe starts a new "
+                     "one: use one")
     try:
         if args.resume:
             run = Path(args.resume)
@@ -700,9 +745,9 @@ def main(argv: list[str] | None = None) -> int:
                                  f"{config.checkpoint_freq} steps and when a run is "
                                  f"interrupted); start a new run with another --out")
         else:
-            settings = load_hyperparams(args.env, args.hyperparams)
+            env_id, settings = starting_settings(parser, args)
             settings.update(parse_overrides(args.hp))
-            config = make_config(args.env, settings, seed=args.seed, timesteps=args.timesteps,
+            config = make_config(env_id, settings, seed=args.seed, timesteps=args.timesteps,
                                  n_envs=args.n_envs, vec=args.vec, device=args.device,
                                  extractor=args.extractor, env_kwargs=args.env_kwargs)
             run = Path(args.out or f"runs/{config.env_id.split('/')[-1]}_{config.extractor}"

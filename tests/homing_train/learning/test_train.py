@@ -2,6 +2,7 @@
 
 import json
 import re
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
@@ -11,7 +12,8 @@ import yaml
 
 from homing_train.learning.extractor import (AlignedBandExtractor, CircularConv, CircularConv1d,
                                              HorizonBandExtractor, PanoramaGoalExtractor)
-from homing_train.learning.train import latest_checkpoint, load_hyperparams, main, make_config, parse_overrides
+from homing_train.learning.train import (latest_checkpoint, load_hyperparams, main, make_config,
+                                         parse_overrides, recipe)
 
 # 36 rows: the smallest height SB3's NatureCNN (inside CombinedExtractor) accepts
 TINY = ["--env-kwargs", json.dumps({"panorama_shape": [36, 64], "max_episode_steps": 16}),
@@ -119,6 +121,29 @@ def test_hyperparameters_merge_and_reject_unknown_keys(tmp_path):
     bad.write_text("default: [unclosed")
     with pytest.raises(ValueError, match="bad.yml"):
         load_hyperparams("homing_gym/LocalHoming-v0", bad)
+
+
+def test_a_shipped_recipe_rebuilds_the_config_its_policy_was_trained_with(tmp_path, capsys):
+    recorded = yaml.safe_load(Path("train/shipped/ppo_procedural_fast.yml").read_text())
+    env_id, settings = recipe("ppo_procedural_fast")
+    assert env_id == "homing_gym/LocalHoming-v0" and settings["n_steps"] == 64
+    config = make_config(env_id, settings)
+    assert asdict(config) == recorded["config"]
+    reseeded = make_config(env_id, {**settings, **parse_overrides(["n_epochs=3"])}, seed=1)
+    assert (reseeded.seed, reseeded.ppo["n_epochs"], reseeded.n_envs) == (1, 3, 64)
+    with pytest.raises(ValueError, match="unknown recipe 'ppo_fast'.*ppo_procedural_fast"):
+        recipe("ppo_fast")
+    (tmp_path / "old.yml").write_text("env_id: homing_gym/LocalHoming-v0\n")
+    with pytest.raises(ValueError, match="old.yml records no training config"):
+        recipe("old", tmp_path)
+    for bad in (["--recipe", "ppo_procedural_fast", "--env", "homing_gym/RouteFollowing-v0"],
+                ["--recipe", "ppo_procedural_fast", "--resume", str(tmp_path)],
+                ["--recipe", "ppo_procedural_fast", "--hyperparams", str(tmp_path / "old.yml")],
+                ["--recipe", "nope"]):
+        with pytest.raises(SystemExit):
+            main(bad + ["--out", str(tmp_path / "run")])
+    assert "RouteFollowing" in capsys.readouterr().err
+    assert not (tmp_path / "run").exists()
 
 
 def test_circular_padding_makes_the_extractor_equivariant_to_azimuth_shifts():
