@@ -110,12 +110,30 @@ def last_stage(path: Path) -> tuple[int, list[dict]]:
 
 
 def mark_stages(ax, stages: list[dict]) -> None:
-    """Dashed lines on ``ax`` (x: env steps) where each stage after the first began."""
+    """Dashed lines on ``ax`` (x: env steps, already plotted) where each stage after the
+    first began, numbered at the top right of the line; stages closer together than 4% of
+    the x range share one label (``"1-5"``, right of the last) instead of printing over
+    each other."""
+    lo, hi = ax.get_xlim()
+    groups: list[list[dict]] = []
     for stage in stages[1:]:
         ax.axvline(stage["from_step"], color="tab:gray", ls="--", lw=1)
-        ax.annotate(f"stage {stage['stage']}: {stage_label(stage)}", (stage["from_step"], 1),
-                    xycoords=("data", "axes fraction"), color="tab:gray", rotation=90,
-                    va="top", ha="right", fontsize=8)
+        if groups and stage["from_step"] - groups[-1][-1]["from_step"] < 0.04 * (hi - lo):
+            groups[-1].append(stage)
+        else:
+            groups.append([stage])
+    for group in groups:
+        first, last = group[0]["stage"], group[-1]["stage"]
+        ax.annotate(str(first) if first == last else f"{first}-{last}",
+                    (group[-1]["from_step"], 1), xycoords=("data", "axes fraction"),
+                    xytext=(2, -2), textcoords="offset points", color="tab:gray",
+                    va="top", ha="left", fontsize=8)
+
+
+def stage_key(stages: list[dict]) -> str:
+    """One line per stage: ``"stage 2 from 216k: 0.3-1.5 m, radius 0.3 m"``."""
+    return "\n".join(f"stage {s['stage']} from {s['from_step'] / 1000:.0f}k: {stage_label(s)}"
+                     for s in stages)
 
 
 def stage_label(stage: dict) -> str:
@@ -140,8 +158,10 @@ def plot_training_success(ax, tb: Path, stages: list[dict]) -> None:
             points.update((e.step, e.value) for e in accumulator.Scalars("curriculum/success_rate"))
     steps = sorted(points)
     ax.plot(steps, [100 * points[s] for s in steps], color="tab:orange")
-    mark_stages(ax, stages)
     ax.set_xlabel("environment steps")
     ax.set_ylabel("training success rate (%)")
     ax.set_ylim(0, 100)
-    ax.set_title(f"training episodes (stage 0: {stage_label(stages[0])})")
+    mark_stages(ax, stages)
+    ax.text(0.98, 0.03, stage_key(stages), transform=ax.transAxes, ha="right", va="bottom",
+            fontsize=7, color="0.3", bbox={"facecolor": "white", "alpha": 0.8, "lw": 0})
+    ax.set_title(f"training episodes (curriculum: {len(stages)} stages)")

@@ -8,7 +8,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from homing_train.learning.curriculum import CurriculumSettings, last_stage
+from homing_train.learning.curriculum import CurriculumSettings, last_stage, mark_stages, stage_key
 from homing_train.learning.curriculum_callback import CurriculumCallback
 from homing_train.learning.train import check_curriculum, main, make_config, make_monitored_env
 
@@ -210,3 +210,22 @@ def test_a_run_logs_its_stages_and_a_resumed_run_goes_on_at_its_last_stage(tmp_p
         stages += [e.value for e in accumulator.Scalars("curriculum/stage")]
     assert stages == [0, 1]         # one rollout per session
     assert (run / "learning_curve.png").is_file()
+
+
+def test_stage_marks_share_a_label_when_too_close_to_read_apart():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    stages = [{"stage": k, "from_step": step, "start_distance": [0.3, 1.5],
+               "success_radius": 0.15} for k, step in
+              enumerate([0, 180_000, 216_000, 250_000, 1_500_000])]
+    fig, ax = plt.subplots()
+    ax.plot([0, 3_000_000], [0, 1])
+    mark_stages(ax, stages)
+    assert [t.get_text() for t in ax.texts] == ["1-3", "4"]
+    assert len(ax.lines) == 1 + 4
+    plt.close(fig)
+    assert stage_key(stages[:2]).splitlines() == [
+        "stage 0 from 0k: 0.3-1.5 m, radius 0.15 m", "stage 1 from 180k: 0.3-1.5 m, radius 0.15 m"]
