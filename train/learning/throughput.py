@@ -3,9 +3,12 @@
 Three measurements in one process, with the configuration's envs (``n_envs`` of them,
 ``vec`` workers), network and PPO settings:
 
-* ``env``: env steps per second of the vectorised envs alone, random actions;
+* ``env``: env steps per second of the vectorised envs alone (``env.step``'s time only),
+  with the model's own sampled actions: a trained network's episodes (``init_policy``)
+  rather than a random one's, whose stop action ends most episodes within a few steps;
 * ``inference``: samples per second of the policy's forward pass (sampling actions), on
-  batches of ``n_envs`` observations, as during rollouts;
+  the batches of ``n_envs`` observations of the same loop, on one torch thread as during
+  rollouts (:func:`~homing_train.learning.thread_split.phase_threads`);
 * ``ppo``: env steps per second of ``PPO.learn`` end to end, split into the time spent
   collecting rollouts (envs and inference) and the time spent updating (``n_epochs``
   passes of minibatches of ``batch_size``), timed with SB3's rollout callbacks.
@@ -18,8 +21,6 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-
-import numpy as np
 
 
 @dataclass
@@ -72,17 +73,19 @@ def measure(env, model, steps: int, label: str) -> Throughput:
 
     n_envs = env.num_envs
     rounds = max(steps // n_envs, 1)
-    env.reset()
-    t0 = time.perf_counter()
-    for _ in range(rounds):
-        env.step(np.array([env.action_space.sample() for _ in range(n_envs)]))
-    env_rate = rounds * n_envs / (time.perf_counter() - t0)
     obs = env.reset()
     model.policy.set_training_mode(False)
-    t0 = time.perf_counter()
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    env_s = inference_s = 0.0
     for _ in range(rounds):
-        model.predict(obs, deterministic=False)
-    inference = rounds * n_envs / (time.perf_counter() - t0)
+        t0 = time.perf_counter()
+        actions, _ = model.predict(obs, deterministic=False)
+        t1 = time.perf_counter()
+        obs = env.step(actions)[0]
+        env_s, inference_s = env_s + time.perf_counter() - t1, inference_s + t1 - t0
+    torch.set_num_threads(threads)
+    env_rate, inference = rounds * n_envs / env_s, rounds * n_envs / inference_s
     model.set_logger(Logger(None, []))       # SB3's default makes a folder in /tmp per run
     timer = _rollout_timer()
     t0 = time.perf_counter()
@@ -95,7 +98,7 @@ def measure(env, model, steps: int, label: str) -> Throughput:
 
 def table(rows: list[Throughput]) -> str:
     """A Markdown table of the measurements."""
-    lines = ["| configuration | envs | env steps/s (random actions) | inference samples/s | "
+    lines = ["| configuration | envs | env steps/s (the model's actions) | inference samples/s | "
              "PPO env steps/s | rollout s | update s | update share |",
              "|---|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
