@@ -9,3 +9,6 @@ Installed as ``homing_train`` from the ``train/`` folder. One subpackage per job
 * :mod:`homing_train.figures`: the scripts that reproduce each paper page's figures and
   tables (commands, not library API).
 """
+
+#: The env the commands (``homing-eval``, ``homing-train``, ...) use unless told otherwise.
+DEFAULT_ENV = "homing_gym/LocalHoming-v0"

@@ -33,6 +33,7 @@ from homing_gym.validation import require_positive
 from homing_gym.env import simulation_settings
 from homing_gym.paths import NoPathError, path_length, shortest_path
 from homing_gym.geometry import wrap_angle
+from homing_train import DEFAULT_ENV
 from homing_train.extras import require_extra
 from homing_train.harness import metrics
 from homing_train.harness.policies import (PolicySpec, parse_params, policy_spec,
@@ -40,7 +41,6 @@ from homing_train.harness.policies import (PolicySpec, parse_params, policy_spec
 from homing_train.harness.rollout import prepare_policy, rollout
 
 SCHEMA = 1
-DEFAULT_ENV = "homing_gym/LocalHoming-v0"
 
 
 @dataclass

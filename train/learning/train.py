@@ -42,6 +42,7 @@ import yaml
 
 import homing_gym
 from homing_gym.cli import command_parser, seed_value
+from homing_train import DEFAULT_ENV
 from homing_train.extras import MissingExtraError, require_extra
 from homing_train.harness.protocols import UNSEEN_SEED
 from homing_train.learning import EXTRACTORS
@@ -53,7 +54,6 @@ from homing_train.learning.ppo_settings import (PPO_KEYS, check_device, check_pp
                                                extractor_arguments, ppo_arguments)
 from homing_train.learning.pretrain import pretrain
 
-DEFAULT_ENV = "homing_gym/LocalHoming-v0"
 HYPERPARAMS = Path(str(resources.files("homing_train.learning") / "hyperparams" / "ppo.yml"))
 EVAL_SEED_OFFSET = 1_000_000
 IMITATION_SEED_OFFSET = 2_000_000
