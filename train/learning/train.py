@@ -747,6 +747,12 @@ def main(argv: list[str] | None = None) -> int:
         else:
             env_id, settings = starting_settings(parser, args)
             settings.update(parse_overrides(args.hp))
+            start = settings.get("init_policy")
+            if args.recipe and start and not Path(start).is_file():
+                raise ValueError(f"--recipe {args.recipe} starts from init_policy {start!r}, "
+                                 f"a file of the machine that trained it, not here: give one "
+                                 f"with --hp init_policy=ZIP, or start from scratch with --hp "
+                                 f"init_policy=null")
             config = make_config(env_id, settings, seed=args.seed, timesteps=args.timesteps,
                                  n_envs=args.n_envs, vec=args.vec, device=args.device,
                                  extractor=args.extractor, env_kwargs=args.env_kwargs)

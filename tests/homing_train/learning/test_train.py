@@ -143,6 +143,9 @@ def test_a_shipped_recipe_rebuilds_the_config_its_policy_was_trained_with(tmp_pa
         with pytest.raises(SystemExit):
             main(bad + ["--out", str(tmp_path / "run")])
     assert "RouteFollowing" in capsys.readouterr().err
+    with pytest.raises(SystemExit):     # its warm start was a file of another machine
+        main(["--recipe", "ppo_localhoming", "--out", str(tmp_path / "run")])
+    assert "--hp init_policy=null" in capsys.readouterr().err
     assert not (tmp_path / "run").exists()
 
 
