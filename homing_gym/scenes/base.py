@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import wraps
+from weakref import WeakKeyDictionary
 
 import numpy as np
 
-from homing_gym.scenes.footprint import mesh_clearances
+from homing_gym.scenes.footprint import ClearanceField, clearance_field
 from homing_gym.scenes.mesh_part import MeshPart
 from homing_gym.textures import check_texture
 from homing_gym.validation import require_positive
@@ -208,7 +209,25 @@ class _Obstacles:
     radius: np.ndarray      # (L,) cylinder radii (0 for boxes)
 
 
-@lru_cache(maxsize=32)
+def _per_scene(build):
+    """``build(scene)``, computed at a scene's first use and kept as long as the scene
+    lives (an env keeps its world's scene until it builds the next world), however many
+    other worlds are in use meanwhile (64 envs in one process, say); ``.cache`` holds them."""
+    cache: WeakKeyDictionary = WeakKeyDictionary()
+
+    @wraps(build)
+    def cached(scene: Scene):
+        try:
+            return cache[scene]
+        except KeyError:
+            value = cache[scene] = build(scene)
+            return value
+
+    cached.cache = cache
+    return cached
+
+
+@_per_scene
 def _obstacles(scene: Scene) -> _Obstacles:
     walls, lms = scene.walls, scene.landmarks
     starts = np.array([w.start for w in walls], np.float64).reshape(-1, 2)
@@ -223,6 +242,13 @@ def _obstacles(scene: Scene) -> _Obstacles:
         half_extent=np.array([(lm.extent[0] / 2, lm.extent[1] / 2) if b else (0.0, 0.0)
                               for lm, b in zip(lms, box)], np.float64).reshape(-1, 2),
         radius=np.array([0.0 if b else lm.radius for lm, b in zip(lms, box)], np.float64))
+
+
+@_per_scene
+def _mesh_field(scene: Scene) -> ClearanceField | None:
+    """The clearance field of ``scene``'s colliding mesh parts
+    (:func:`~homing_gym.scenes.footprint.clearance_field`), ``None`` when none blocks."""
+    return clearance_field(scene.meshes, scene.bounds, scene.height_band)
 
 
 def clearances(scene: Scene, points) -> np.ndarray:
@@ -248,9 +274,9 @@ def clearances(scene: Scene, points) -> np.ndarray:
         lx = np.maximum(np.abs(c * d[..., 0] + s * d[..., 1]) - ob.half_extent[:, 0], 0.0)
         ly = np.maximum(np.abs(-s * d[..., 0] + c * d[..., 1]) - ob.half_extent[:, 1], 0.0)
         free = np.minimum(free, np.min(np.maximum(np.hypot(lx, ly) - ob.radius, 0.0), axis=1))
-    if scene.meshes:
-        free = np.minimum(free, mesh_clearances(scene.meshes, scene.bounds, scene.height_band,
-                                                pts))
+    field = _mesh_field(scene) if scene.meshes else None
+    if field is not None:
+        free = np.minimum(free, field(pts))
     return free
 
 

@@ -7,7 +7,7 @@ over the camera): a table's legs block, its top does not. The triangles are clip
 band with ``trimesh.intersections.slice_faces_plane``; the clipped polygons, seen from
 above, are filled into an occupancy grid (OpenCV, sub-pixel precision; a vertical wall
 fills the cells its trace crosses) and ``scipy.ndimage.distance_transform_edt`` gives each
-cell's distance to the nearest blocked cell. :func:`mesh_clearances` reads that field with
+cell's distance to the nearest blocked cell. A :class:`ClearanceField` reads that field with
 bilinear interpolation, less one cell size, so it never claims more room than there is
 (it may claim up to about one cell less). The inside of a closed solid (a watertight
 component wound outwards: a pillar, a rock) is blocked too: the floor outline of its
@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import lru_cache
 
 import cv2
 import numpy as np
@@ -141,16 +140,3 @@ def clearance_field(parts: tuple[MeshPart, ...], bounds, band) -> ClearanceField
     distance = ndimage.distance_transform_edt(~blocked) * resolution - resolution
     return ClearanceField(np.maximum(distance, 0.0), (float(origin[0]), float(origin[1])),
                           resolution)
-
-
-@lru_cache(maxsize=16)
-def _field(parts: tuple[MeshPart, ...], bounds, band) -> ClearanceField | None:
-    return clearance_field(parts, bounds, band)
-
-
-def mesh_clearances(parts: tuple[MeshPart, ...], bounds, band, points) -> np.ndarray:
-    """Free distance (metres) from floor points ``(N, 2)`` to the nearest colliding mesh
-    triangle in ``band`` (``inf`` when no part blocks anything); cached per world."""
-    field = _field(parts, bounds, band)
-    pts = np.asarray(points, np.float64).reshape(-1, 2)
-    return np.full(len(pts), np.inf) if field is None else field(pts)

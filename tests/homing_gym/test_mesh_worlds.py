@@ -40,6 +40,28 @@ def test_mesh_file_bounds_and_clearance_match_the_geometry(room_files, name):
     assert clearance(scene, (1.4, 0.8)) > 0.3          # the table top does not block
 
 
+def test_each_live_mesh_scene_builds_its_clearance_field_once(monkeypatch):
+    """Many mesh worlds in use at once (64 envs in one process): each world's field is
+    built at its first use and kept while its scene lives, then freed with it."""
+    import gc
+
+    from homing_gym.scenes import base, footprint
+
+    built = []
+    monkeypatch.setattr(base, "clearance_field",
+                        lambda *a: built.append(a) or footprint.clearance_field(*a))
+    box = trimesh.creation.box((0.4, 0.4, 0.5))
+    scenes = [MeshScene.from_arrays(box.vertices + (0.02 * k, 0.0, 0.25), box.faces,
+                                    bounds=((-3, -3), (3, 3))) for k in range(40)]
+    for _ in range(3):
+        for k, scene in enumerate(scenes):       # the box's face at x = 0.2 + 0.02 k
+            assert clearance(scene, (1.5, 0.0)) == pytest.approx(1.3 - 0.02 * k, abs=0.045)
+    assert len(built) == 40
+    del scenes, scene
+    gc.collect()
+    assert len(base._mesh_field.cache) == 0
+
+
 def test_glb_parts_keep_their_names_and_colours(room_files):
     scene = MeshScene.from_file(room_files / "room.glb", no_collision=("pillar",))
     parts = {p.name: p for p in scene.meshes}
