@@ -12,13 +12,12 @@ walls, landmarks and the scene bounds.
 from __future__ import annotations
 
 import math
-from functools import lru_cache
 
 import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from homing_gym.scenes.base import Scene, clearances
+from homing_gym.scenes.base import Scene, clearances, per_scene
 
 # the four forward steps (dx >= 0) of the 8-connected grid and their lengths (cells)
 #: Floor points whose clearances are computed at once (bounds the memory of big worlds).
@@ -30,7 +29,7 @@ class NoPathError(ValueError):
     """Start and goal are not connected for a disc of the given radius."""
 
 
-@lru_cache(maxsize=16)
+@per_scene
 def occupancy(scene: Scene, radius: float, resolution: float) -> tuple[np.ndarray, tuple]:
     """Boolean grid, True where a disc of ``radius`` centred on the cell fits; and the
     grid origin ``(xmin, ymin)`` (centre of cell (0, 0)). Cached per scene."""

@@ -209,25 +209,27 @@ class _Obstacles:
     radius: np.ndarray      # (L,) cylinder radii (0 for boxes)
 
 
-def _per_scene(build):
-    """``build(scene)``, computed at a scene's first use and kept as long as the scene
-    lives (an env keeps its world's scene until it builds the next world), however many
-    other worlds are in use meanwhile (64 envs in one process, say); ``.cache`` holds them."""
+def per_scene(build):
+    """``build(scene, *args)`` (hashable ``args``), computed at its first use and kept as
+    long as the scene lives (an env keeps its world's scene until it builds the next
+    world), however many other worlds are in use meanwhile (64 envs in one process, say);
+    ``.cache`` maps each live scene to its values by ``args``."""
     cache: WeakKeyDictionary = WeakKeyDictionary()
 
     @wraps(build)
-    def cached(scene: Scene):
+    def cached(scene: Scene, *args):
+        values = cache.setdefault(scene, {})
         try:
-            return cache[scene]
+            return values[args]
         except KeyError:
-            value = cache[scene] = build(scene)
+            value = values[args] = build(scene, *args)
             return value
 
     cached.cache = cache
     return cached
 
 
-@_per_scene
+@per_scene
 def _obstacles(scene: Scene) -> _Obstacles:
     walls, lms = scene.walls, scene.landmarks
     starts = np.array([w.start for w in walls], np.float64).reshape(-1, 2)
@@ -244,7 +246,7 @@ def _obstacles(scene: Scene) -> _Obstacles:
         radius=np.array([0.0 if b else lm.radius for lm, b in zip(lms, box)], np.float64))
 
 
-@_per_scene
+@per_scene
 def _mesh_field(scene: Scene) -> ClearanceField | None:
     """The clearance field of ``scene``'s colliding mesh parts
     (:func:`~homing_gym.scenes.footprint.clearance_field`), ``None`` when none blocks."""
