@@ -35,7 +35,8 @@ from homing_gym.validation import is_real
 class Controller(ABC):
     """Base class of scripted controllers. Fields common to all of them:
 
-    ``motion``: ``"turn_then_drive"`` or ``"pursuit"`` (see :mod:`homing_baselines.motion`).
+    ``motion``: ``"turn_then_drive"``, ``"pursuit"`` or ``"reversing"`` (see
+    :mod:`homing_baselines.motion`).
     """
 
     motion: str = "turn_then_drive"
@@ -131,6 +132,13 @@ class Controller(ABC):
     def motion_spec(self) -> MotionSpec:
         return self._helper.spec
 
+    @property
+    def last_travel(self) -> float | None:
+        """Direction (radians, CCW, in the robot's frame now) in which the last move
+        translated the robot, once that move has been played (the open-loop plan's, not
+        a measurement); None before the episode's first translation."""
+        return self._helper.travel
+
     def attach_env(self, env) -> None:
         """Only for ``needs_env`` controllers (oracles); others refuse."""
         raise TypeError(f"controller {self.name or type(self).__name__!r} decides from "
@@ -140,6 +148,7 @@ class Controller(ABC):
         """Start a new episode: forget the current move and per-episode memory.
         ``seed`` (the episode seed) makes stochastic controllers reproducible."""
         self._queue = []
+        self._helper.travel = None
         self._seed = seed
         self.last_direction = None
         self.last_home_direction = None

@@ -31,7 +31,15 @@ Choices where the paper is open (also in ``docs/bearing.md``):
   decisions; they are set so that they cover at least the distances of the 2-D
   simulator (20 cm and 5 cm at 1 cm per step) at ``min_step`` per decision (10 and 3
   decisions): on the NLP arc, where criterion 4 is judged, ``|M|`` is small and the
-  steps are short. Shorter spans read pixel noise as a trend.
+  steps are short. Shorter spans read pixel noise as a trend. Near the arc the law's
+  direction often flips back and forth from one decision to the next (the robot steps
+  across a curve the field converges onto), and a 3-decision window then reads the
+  phase of those steps: ``trend_from="arrival"`` with ``trend_margin`` about the
+  separations' noise judges the change since the robot reached the arc instead
+  (``docs/bearing.md``, "Homes anywhere in the lab"). The defaults keep the window.
+* **Backing up.** ``motion="reversing"`` (:mod:`homing_baselines.motion`) drives a
+  direction behind the robot backwards instead of turning round first: the paper's robot
+  follows ``M`` continuously, where ours spends up to 20 actions on each half turn.
 * **A landmark hidden behind another column** (:meth:`BearingController.bearings_with_occluded`):
   the paper's tracker "was able to recapture the landmark as soon as it reappeared"
   (§5) but the paper does not say what the robot does meanwhile. A landmark missing now
@@ -76,12 +84,15 @@ PALETTE: dict[str, BlobColor] = {c.name: c for c in LAB_COLORS}
 class BearingLawController(Controller):
     """What every controller driven by the laws of §2 shares: the step along ``M`` and the
     unified law's timing (module docstring). ``step_length`` and ``min_step`` (metres),
-    ``gain`` (metres per radian of ``|M|``), ``stop_tol`` (radians)."""
+    ``gain`` (metres per radian of ``|M|``), ``stop_tol`` (radians); ``trend_from`` and
+    ``trend_margin`` (radians): how criterion 4 reads a trend (:class:`UnifiedConfig`)."""
 
     step_length: float = 0.10
     min_step: float = 0.02
     gain: float = 0.3
     stop_tol: float = 0.02
+    trend_from: str = "window"
+    trend_margin: float = 0.0
 
     #: Landmarks are identified by colour: the shipped scene with three distinctly
     #: coloured landmarks is ``lab`` (the ``arena``'s four red cylinders are one colour).
@@ -96,12 +107,14 @@ class BearingLawController(Controller):
         for name in ("gain", "stop_tol"):
             value = getattr(self, name)
             require_positive(name, value)
+        self.unified_config()      # ValueError naming a bad trend_from or trend_margin
 
     def unified_config(self) -> UnifiedConfig:
         """Algorithm 1's settings at this controller's step length (module docstring)."""
         return UnifiedConfig(dwell=max(1, math.ceil(0.2 / self.min_step)),
                              trend_steps=max(1, math.ceil(0.05 / self.min_step)),
-                             stop_tol=self.stop_tol)
+                             stop_tol=self.stop_tol, trend_from=self.trend_from,
+                             trend_margin=self.trend_margin)
 
     def move_along(self, result: LawResult) -> Move:
         """The step along the law's motion vector (length ``gain * |M| * 3 / P``, clipped;
@@ -114,7 +127,7 @@ class BearingLawController(Controller):
         direction) by ``min_step``, or a quarter turn on the spot before any move."""
         if self.last_direction is None:
             return Move(math.pi / 2, 0.0)
-        return Move(0.0, self.min_step)
+        return Move(self.last_travel or 0.0, self.min_step)
 
 
 @dataclass

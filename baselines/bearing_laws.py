@@ -337,7 +337,11 @@ class UnifiedConfig:
     landmark-goal circle). ``no_crossing``: criterion 3's decision when the robot leaves
     ``T^`` without having crossed any landmark-goal circle: ``"uncertain"`` (default: no
     information, stay UNCERTAIN) or ``"basic"`` (Algorithm 1's literal ``else``).
-    ``stop_tol``: the stop test, see :func:`snapshots_similar`.
+    ``stop_tol``: the stop test, see :func:`snapshots_similar`. ``trend_from``:
+    ``"window"`` compares with ``trend_steps`` steps earlier; ``"arrival"`` with the
+    values when ``A`` reached the arc (the change accumulates as the robot slides along
+    it, where a short window of a robot that steps back and forth reads the phase of its
+    steps). ``trend_margin``: a change counts only beyond this (radians; measurement noise).
     """
 
     circle_tol: float = 0.01
@@ -347,9 +351,14 @@ class UnifiedConfig:
     goal_margin: float = 0.05
     no_crossing: Literal["uncertain", "basic"] = "uncertain"
     stop_tol: float = DEFAULT_STOP_TOL
+    trend_from: Literal["window", "arrival"] = "window"
+    trend_margin: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("circle_tol", "arc_band", "goal_margin", "stop_tol"):
+        if self.trend_from not in ("window", "arrival"):
+            raise ValueError(f"UnifiedConfig.trend_from must be 'window' or 'arrival', "
+                             f"got {self.trend_from!r}")
+        for name in ("circle_tol", "arc_band", "goal_margin", "stop_tol", "trend_margin"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0):
                 raise ValueError(f"UnifiedConfig.{name} must be finite and >= 0, got {value!r}")
@@ -378,6 +387,7 @@ class UnifiedBatch:
     _prev_in_t: np.ndarray | None = None   # (B,) A in T^ at the previous step
     _prev_armed: np.ndarray | None = None  # (B,) criterion 3's condition at the previous step
     _prev_d_nlp: np.ndarray | None = None  # (B,) Delta theta_NLP at the previous step
+    _arrival: np.ndarray | None = None     # (B, P) |g(Delta theta)| when A reached the arc
     _gains: list = field(default_factory=list)  # last (B, P) |g(Delta theta)|
 
     def step(self, current, goal) -> np.ndarray:
@@ -434,12 +444,16 @@ class UnifiedBatch:
                 & (self._prev_d_nlp * d_nlp <= 0)
         self.on_arc_steps = np.where(on_arc & ((self.on_arc_steps > 0) | reached),
                                      self.on_arc_steps + 1, 0)
+        arrived = self.on_arc_steps == 1
+        self._arrival = np.where(arrived[:, None], gain,
+                                 gain if self._arrival is None else self._arrival)
         judged = (self.on_arc_steps >= cfg.dwell) & (gain.max(axis=1) > cfg.goal_margin)
         self._gains = (self._gains + [gain])[-(cfg.trend_steps + 1):]
-        if len(self._gains) > cfg.trend_steps:
-            change = np.where(is_nlp, np.nan, gain - self._gains[0])
-            increasing = np.nanmin(change, axis=1) > 0
-            decreasing = np.nanmax(change, axis=1) < 0
+        if cfg.trend_from == "arrival" or len(self._gains) > cfg.trend_steps:
+            before = self._arrival if cfg.trend_from == "arrival" else self._gains[0]
+            change = np.where(is_nlp, np.nan, gain - before)
+            increasing = np.nanmin(change, axis=1) > cfg.trend_margin
+            decreasing = np.nanmax(change, axis=1) < -cfg.trend_margin
         else:
             increasing = decreasing = np.zeros(b, dtype=bool)
 
@@ -512,7 +526,9 @@ class UnifiedLaw:
       "The non-NLP differences ... are increasing": *each* non-NLP ``|g(Delta theta_ij)|``
       grew over the last ``trend_steps`` steps -> COMPLEMENTARY; each shrank -> BASIC (the
       criterion's text: "reachable by the basic control law if ... decreasing");
-      mixed -> still UNCERTAIN, judged again at the next step.
+      mixed -> still UNCERTAIN, judged again at the next step. From noisy bearings
+      (pixels), ``trend_from="arrival"`` compares with the values at the arc's arrival
+      and counts a change only beyond ``trend_margin``.
     * For ``N > 3`` landmarks the criteria are applied as written with ``T^`` the convex
       hull; the paper's guarantees are for three landmarks.
     """

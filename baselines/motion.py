@@ -7,7 +7,15 @@ that executes it open loop, for both action types of the env, in one of two styl
 
 * ``"turn_then_drive"``: turn on the spot by the direction, then drive straight;
 * ``"pursuit"``: a smooth circular arc through the target point (turn and drive at once;
-  turns on the spot first only when the target is more than 45 degrees off the heading).
+  turns on the spot first only when the target is more than 45 degrees off the heading);
+* ``"reversing"``: turn then drive, but a direction more than 90 degrees off the heading is
+  driven backwards after turning the tail towards it (a turn of at most 90 degrees instead
+  of up to 180): a controller whose direction flips back and forth, as a vector field's
+  does along a curve it converges onto, then spends one or two actions per flip instead of
+  a half turn.
+
+With discrete actions both ``"pursuit"`` and ``"reversing"`` turn then drive: the discrete
+set has neither arcs nor a backward action.
 
 On a synchro-drive robot (``drive="synchro"``: it translates without turning, as Hong et
 al.'s did) either style translates straight along the direction, and a move of length
@@ -29,7 +37,7 @@ import numpy as np
 from homing_gym.actions import DiscreteAction
 from homing_gym.geometry import wrap_angle
 
-MOTION_STYLES = ("turn_then_drive", "pursuit")
+MOTION_STYLES = ("turn_then_drive", "pursuit", "reversing")
 
 
 @dataclass(frozen=True)
@@ -102,6 +110,11 @@ class MotionHelper:
         self.spec = spec
         self.style = style
         self.pursuit_gain = float(pursuit_gain)
+        #: Direction (radians, CCW, robot frame when the move ends) in which the last
+        #: planned move translated: 0 driving forward, pi backwards, the move's own
+        #: direction on a synchro drive (the body keeps its heading); None before any
+        #: translation.
+        self.travel: float | None = None
 
     def stop_action(self):
         """The env's stop signal: discrete action 3 or the continuous action (0, 0)."""
@@ -112,12 +125,25 @@ class MotionHelper:
     def plan(self, move: Move) -> list:
         """Actions that carry out ``move``; empty if the move is below one command's
         resolution (it would otherwise read as a stop)."""
+        actions, travel = self._plan(move)
+        if move.distance > 0 and actions:
+            self.travel = travel
+        return actions
+
+    def _plan(self, move: Move) -> tuple[list, float]:
+        """The actions and the direction of travel at the end of the move (see
+        :attr:`travel`)."""
         if self.spec.drive == "synchro":
-            return self._translate(move)
+            return self._translate(move), float(wrap_angle(move.direction))
         if self.style == "pursuit" and self.spec.action_type == "continuous" \
                 and move.distance > 0:
-            return self._pursuit(move)
-        return self._turn(wrap_angle(move.direction)) + self._drive(move.distance)
+            return self._pursuit(move), 0.0
+        direction = wrap_angle(move.direction)
+        if self.style == "reversing" and self.spec.action_type == "continuous" \
+                and move.distance > 0 and abs(direction) > math.pi / 2:
+            return self._turn(wrap_angle(direction - math.pi)) + [
+                -action for action in self._drive(move.distance)], math.pi
+        return self._turn(direction) + self._drive(move.distance), 0.0
 
     def _translate(self, move: Move) -> list:
         """Synchro drive: straight along ``move.direction`` at constant speed, the

@@ -13,7 +13,7 @@ from homing_train.harness.policies import parse_params
 ENV_ID = "homing_gym/LocalHoming-v0"
 
 
-@pytest.mark.parametrize("style", ["turn_then_drive", "pursuit"])
+@pytest.mark.parametrize("style", ["turn_then_drive", "pursuit", "reversing"])
 def test_motion_helper_translates_on_a_synchro_drive(style):
     helper = MotionHelper(MotionSpec(drive="synchro"), style)
     actions = helper.plan(Move(0.7, 0.1))            # 0.1 m at 0.03 m per step: 4 steps
@@ -52,7 +52,7 @@ def test_parse_params_types_and_errors():
 
 
 @pytest.mark.parametrize("action_type", ["continuous", "discrete"])
-@pytest.mark.parametrize("style", ["turn_then_drive", "pursuit"])
+@pytest.mark.parametrize("style", ["turn_then_drive", "pursuit", "reversing"])
 def test_motion_helper_reaches_the_move_target_kinematically(action_type, style):
     spec = MotionSpec(action_type=action_type)
     helper = MotionHelper(spec, style)
@@ -72,6 +72,25 @@ def test_motion_helper_reaches_the_move_target_kinematically(action_type, style)
                     assert max(abs(a[0]), abs(a[1])) >= spec.stop_threshold
                 else:
                     assert a != 3
+
+
+def test_reversing_backs_up_instead_of_turning_round():
+    spec = MotionSpec()                              # 0.15 rad and 0.03 m per step
+    reversing, turning = MotionHelper(spec, "reversing"), MotionHelper(spec, "turn_then_drive")
+    assert reversing.travel is None
+    behind = Move(3.0, 0.06)                         # 0.14 rad off straight back
+    actions = reversing.plan(behind)
+    assert len(actions) == 3 and actions[0][1] < 0 and actions[0][0] == 0
+    assert all(a[0] < 0 and a[1] == 0 for a in actions[1:])      # backwards, no turning
+    assert reversing.travel == math.pi                # the robot now travels tail first
+    assert len(turning.plan(behind)) == 22            # 20 turn steps, then 2 forward
+    assert turning.travel == 0.0
+    ahead = Move(1.2, 0.06)                           # within 90 degrees: as turn-then-drive
+    assert [a.tolist() for a in reversing.plan(ahead)] == \
+        [a.tolist() for a in turning.plan(ahead)]
+    assert reversing.travel == 0.0
+    reversing.plan(Move(3.0, 0.0))                    # a turn alone faces the direction
+    assert reversing.travel == 0.0                    # and moves nothing: travel unchanged
 
 
 def test_bad_moves_and_styles_raise():

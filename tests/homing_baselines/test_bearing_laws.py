@@ -281,6 +281,38 @@ def test_circumcircle():
     assert radius == pytest.approx(1.0)
 
 
+def _criterion_4_decision(config: UnifiedConfig, first: float, slope: float):
+    """The unified law's state and step when ``A`` sits on the NLP arc (goal outside the
+    triangle; the NLP pair (0, 2) keeps its goal separation) while both non-NLP
+    differences drift by ``slope`` a step under alternating noise of +-0.002 rad, as the
+    bearings of a robot stepping back and forth across its path do."""
+    goal = np.array([0.0, 1.5, 2.6])
+    law = UnifiedLaw(config)
+    for k in range(40):
+        x = first + slope * k + 0.002 * (-1) ** k
+        law.step(goal + np.array([x, 0.0, x]), goal)
+        if law.state != UnifiedState.UNCERTAIN:
+            assert law.criterion == Criterion.NLP_CIRCLE_TREND
+            return law.state, k
+    return law.state, None
+
+
+def test_criterion_4_from_arrival_reads_the_drift_under_noise_where_a_short_window_fails():
+    window = UnifiedConfig(dwell=10, trend_steps=3)
+    arrival = UnifiedConfig(dwell=10, trend_steps=3, trend_from="arrival", trend_margin=0.005)
+    # growing differences: the complementary law; the 3-step window reads the noise
+    assert _criterion_4_decision(window, 0.06, 0.001)[0] == UnifiedState.BASIC
+    assert _criterion_4_decision(arrival, 0.06, 0.001)[0] == UnifiedState.COMPLEMENTARY
+    # shrinking differences: the basic law either way
+    assert _criterion_4_decision(arrival, 0.12, -0.001)[0] == UnifiedState.BASIC
+    # no drift beyond the margin: no decision
+    assert _criterion_4_decision(arrival, 0.06, 0.0) == (UnifiedState.UNCERTAIN, None)
+    with pytest.raises(ValueError, match="trend_from"):
+        UnifiedConfig(trend_from="start")
+    with pytest.raises(ValueError, match="trend_margin"):
+        UnifiedConfig(trend_margin=-0.1)
+
+
 # --------------------------------------------------------------------------------------
 # Bad input
 # --------------------------------------------------------------------------------------

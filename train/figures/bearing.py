@@ -34,7 +34,8 @@ the paper's numbers.
     python -m homing_train.figures.bearing lab-anywhere --episodes 40 --out docs/bearing
 
 ``lab-anywhere`` runs the unified law to the env's own homes anywhere in the lab and
-asks the 2-D simulator whether each goal is reachable from its start.
+asks the 2-D simulator whether each goal is reachable from its start; ``--param`` sets
+the controller, ``--panorama-shape ROWS COLUMNS`` the env's panorama.
 ``pixel-reachability`` is the Fig. 4 map measured from pixels: the three laws from one
 start to a coarse grid of goals in the lab (``pixel_reachability.png`` and ``.json``).
 ``longrange`` runs ``bearing-longrange`` (§3) on seeded ``LongRangeHoming-v0`` episodes
@@ -427,7 +428,8 @@ def pixel_reachability(out: str, spacing: float = 1.2, max_steps: int = 600,
 
 
 def lab_anywhere(out: str, episodes: int = 40, seed: int = 0, max_steps: int = 800,
-                 progress: bool = True, params: dict | None = None) -> dict:
+                 progress: bool = True, params: dict | None = None,
+                 panorama_shape: tuple[int, int] | None = None) -> dict:
     """The unified law (``bearing``) in ``LocalHoming-v0`` in the lab with the env's own
     homes (anywhere in the room) and starts (0.3-1.5 m away), seeds ``seed`` ... ``seed +
     episodes - 1``, a success being a stop within the env's 0.15 m. Each episode is also
@@ -437,7 +439,8 @@ def lab_anywhere(out: str, episodes: int = 40, seed: int = 0, max_steps: int = 8
     ``near_circle``: the home lies within 0.1 m of the circle ``C^``
     (left out of the reachability tables: the snapshot barely fixes the position there);
     ``goal_landmarks``: poster colours seen in the goal panorama (the laws need three).
-    ``params``: the controller's parameters other than its defaults. Writes
+    ``params``: the controller's parameters other than its defaults; ``panorama_shape``
+    ``(rows, columns)``: the env's panorama if not its default. Writes
     ``lab_anywhere.json``; returns the counts."""
     import gymnasium as gym
 
@@ -449,8 +452,9 @@ def lab_anywhere(out: str, episodes: int = 40, seed: int = 0, max_steps: int = 8
     from homing_train.harness.rollout import prepare_policy
 
     gym.register_envs(homing_gym)
+    shape = {} if panorama_shape is None else {"panorama_shape": tuple(panorama_shape)}
     env = gym.make("homing_gym/LocalHoming-v0", scene="lab", success_on="stop",
-                   max_episode_steps=max_steps, **MEASURED_WITH)
+                   max_episode_steps=max_steps, **MEASURED_WITH, **shape)
     triangle = np.array([pos for _, pos in POSTERS.values()])
     centre, radius = circumcircle(triangle)
     scene = env.unwrapped.scene
@@ -474,6 +478,7 @@ def lab_anywhere(out: str, episodes: int = 40, seed: int = 0, max_steps: int = 8
         os.makedirs(out, exist_ok=True)
         with open(os.path.join(out, "lab_anywhere.json"), "w") as f:
             json.dump({"seed": seed, "max_steps": max_steps, "params": params or {},
+                       "panorama_shape": list(env.unwrapped.camera.config.panorama_shape),
                        "counts": anywhere_counts(runs),
                        "runs": runs}, f, indent=1)
     env.close()
@@ -613,6 +618,8 @@ def main(argv: list[str] | None = None) -> int:
     la.add_argument("--max-steps", type=int, default=800)
     la.add_argument("--param", action="append", metavar="KEY=VALUE",
                     help="a parameter of the bearing controller (repeatable)")
+    la.add_argument("--panorama-shape", type=int, nargs=2, metavar=("ROWS", "COLUMNS"),
+                    help="the env's panorama (default: the env's own)")
     la.add_argument("--no-progress", action="store_true")
     lr = sub.add_parser("longrange", help="bearing-longrange on LongRangeHoming-v0")
     lr.add_argument("--out", default="docs/bearing", help="output folder")
@@ -635,7 +642,8 @@ def main(argv: list[str] | None = None) -> int:
     elif args.command == "lab-anywhere":
         counts = lab_anywhere(args.out, args.episodes, args.seed, args.max_steps,
                               progress=not args.no_progress,
-                              params=parse_params(args.param, "bearing"))
+                              params=parse_params(args.param, "bearing"),
+                              panorama_shape=args.panorama_shape)
         print(json.dumps(counts))
     elif args.command == "fig10":
         runs = fig10(args.out, args.max_steps, args.fail_cm, progress=not args.no_progress)
