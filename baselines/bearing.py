@@ -36,10 +36,13 @@ Choices where the paper is open (also in ``docs/bearing.md``):
   across a curve the field converges onto), and a 3-decision window then reads the
   phase of those steps: ``trend_from="arrival"`` with ``trend_margin`` about the
   separations' noise judges the change since the robot reached the arc instead
-  (``docs/bearing.md``, "Homes anywhere in the lab"). The defaults keep the window.
-* **Backing up.** ``motion="reversing"`` (:mod:`homing_baselines.motion`) drives a
-  direction behind the robot backwards instead of turning round first: the paper's robot
-  follows ``M`` continuously, where ours spends up to 20 actions on each half turn.
+  (``docs/bearing.md``, "Homes anywhere in the lab"): the blob controllers' default,
+  with 0.01 rad, about twice a separation's noise at 256 columns (``bearing-longrange``
+  keeps the window).
+* **Backing up.** ``motion="reversing"`` (:mod:`homing_baselines.motion`), the blob
+  controllers' default, drives a direction behind the robot backwards instead of turning
+  round first: the paper's robot follows ``M`` continuously, where ours spent up to 20
+  actions on each half turn.
 * **A landmark hidden behind another column** (:meth:`BearingController.bearings_with_occluded`):
   the paper's tracker "was able to recapture the landmark as soon as it reappeared"
   (§5) but the paper does not say what the robot does meanwhile. A landmark missing now
@@ -137,12 +140,17 @@ class BearingController(BearingLawController):
     ``occlusion_gap`` (radians: how near a column a landmark must have been to be taken
     as hidden behind it), ``near_width`` (radians: the blob width from which a column is
     near, 0.45 rad = about 0.45 m for the lab's 0.1 m columns) and those of
-    :class:`BearingLawController`. The law is the class's ``law``: ``unified`` here."""
+    :class:`BearingLawController`, with ``motion="reversing"`` and criterion 4 judged from
+    the arc's arrival beyond ``trend_margin`` = 0.01 rad (module docstring). The law is
+    the class's ``law``: ``unified`` here."""
 
     colors: tuple[str, ...] = ("red", "green", "blue")
     min_area: int = 4
     occlusion_gap: float = 0.5
     near_width: float = 0.45
+    motion: str = "reversing"
+    trend_from: str = "arrival"
+    trend_margin: float = 0.01
 
     law: ClassVar[str] = "unified"
     reads_at_decisions_only: ClassVar[bool] = True
