@@ -444,9 +444,10 @@ class UnifiedBatch:
                 & (self._prev_d_nlp * d_nlp <= 0)
         self.on_arc_steps = np.where(on_arc & ((self.on_arc_steps > 0) | reached),
                                      self.on_arc_steps + 1, 0)
-        arrived = self.on_arc_steps == 1
-        self._arrival = np.where(arrived[:, None], gain,
-                                 gain if self._arrival is None else self._arrival)
+        if cfg.trend_from == "arrival":
+            arrived = (self.on_arc_steps == 1)[:, None]
+            self._arrival = np.where(arrived, gain,
+                                     gain if self._arrival is None else self._arrival)
         judged = (self.on_arc_steps >= cfg.dwell) & (gain.max(axis=1) > cfg.goal_margin)
         self._gains = (self._gains + [gain])[-(cfg.trend_steps + 1):]
         if cfg.trend_from == "arrival" or len(self._gains) > cfg.trend_steps:
