@@ -1,7 +1,7 @@
 """One colour per method in every plot, from colour-blind-safe palettes.
 
 Known methods have fixed colours (Okabe & Ito's eight, Paul Tol's muted set, then
-ColorBrewer's dark brown and dark green); any other name (a user's controller or policy) gets a colour
+ColorBrewer's dark brown, dark green and dark purple); any other name (a user's controller or policy) gets a colour
 from the rest, chosen by a stable hash of the name, so it is the same in every plot and
 run. Home and start markers use shapes and colours outside these (:data:`HOME_MARK`,
 :data:`START_MARK`).
@@ -12,11 +12,12 @@ from __future__ import annotations
 import zlib
 
 #: Okabe & Ito (2008), Tol's muted scheme, ColorBrewer's BrBG dark brown and PRGn dark
-#: green, RGB in [0, 1].
+#: green and dark purple, RGB in [0, 1].
 _HEX = {"black": "000000", "orange": "E69F00", "sky": "56B4E9", "green": "009E73",
         "blue": "0072B2", "vermillion": "D55E00", "purple": "CC79A7", "grey": "999999",
         "indigo": "332288", "teal": "44AA99", "olive": "999933", "wine": "882255",
-        "rose": "CC6677", "sand": "DDCC77", "brown": "8C510A", "forest": "1B7837"}
+        "rose": "CC6677", "sand": "DDCC77", "brown": "8C510A", "forest": "1B7837",
+        "plum": "762A83"}
 _FIXED = {"oracle": "black", "random": "grey", "snapshot": "orange", "warping": "sky",
           "distance": "blue", "bearing": "purple", "bearing-basic": "rose",
           "bearing-complementary": "wine", "bearing-longrange": "indigo",
@@ -24,7 +25,7 @@ _FIXED = {"oracle": "black", "random": "grey", "snapshot": "orange", "warping": 
           # the shipped learned policies (train/shipped/)
           "ppo_localhoming": "vermillion", "ppo_procedural_imitation": "green",
           "ppo_procedural": "sand", "ppo_procedural_arena": "brown",
-          "ppo_procedural_fast": "forest"}
+          "ppo_procedural_fast": "forest", "ppo_procedural_long": "plum"}
 _SPARE = ("vermillion", "sand", "green")
 #: Marker colours of the maps (RGB 0-255), used by no method: home a dark navy ring, the
 #: start a light grey ring.

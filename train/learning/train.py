@@ -704,7 +704,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--recipe", metavar="NAME",
                         help="start from the settings the shipped policy NAME was trained "
                              "with (its env, envs, network, PPO settings, curriculum), "
-                             "e.g. ppo_procedural_fast, the default learned policy; --hp "
+                             "e.g. ppo_procedural_long, the default learned policy; --hp "
                              "and the flags override them")
     parser.add_argument("--hp", action="append", default=[], metavar="KEY=VALUE",
                         help="override a hyperparameter (YAML value); repeatable")

@@ -316,7 +316,7 @@ def test_missing_training_extra_is_one_line_and_the_suite_runs_without_it(monkey
     assert err.count("\n") == 0 and 'pip install "homing-gym[train]"' in err
     suite.run_suite(tmp_path, episodes=1, workers=1, methods=["random"])
     out = capsys.readouterr().out
-    assert "learned rows ['ppo_localhoming', 'ppo_procedural', 'ppo_procedural_arena', 'ppo_procedural_fast', 'ppo_procedural_imitation'] are left out" in out
+    assert "learned rows ['ppo_localhoming', 'ppo_procedural', 'ppo_procedural_arena', 'ppo_procedural_fast', 'ppo_procedural_imitation', 'ppo_procedural_long'] are left out" in out
     assert not (tmp_path / "ppo_localhoming.json").exists()
 
 
