@@ -148,7 +148,7 @@ class Controller(ABC):
         """Start a new episode: forget the current move and per-episode memory.
         ``seed`` (the episode seed) makes stochastic controllers reproducible."""
         self._queue = []
-        self._helper.travel = None
+        self._helper.reset()
         self._seed = seed
         self.last_direction = None
         self.last_home_direction = None

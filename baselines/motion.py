@@ -116,6 +116,10 @@ class MotionHelper:
         #: translation.
         self.travel: float | None = None
 
+    def reset(self) -> None:
+        """Start a new episode: no move has translated the robot yet."""
+        self.travel = None
+
     def stop_action(self):
         """The env's stop signal: discrete action 3 or the continuous action (0, 0)."""
         if self.spec.action_type == "discrete":

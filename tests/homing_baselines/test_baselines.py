@@ -91,6 +91,8 @@ def test_reversing_backs_up_instead_of_turning_round():
     assert reversing.travel == 0.0
     reversing.plan(Move(3.0, 0.0))                    # a turn alone faces the direction
     assert reversing.travel == 0.0                    # and moves nothing: travel unchanged
+    reversing.reset()                                 # a new episode: nothing travelled yet
+    assert reversing.travel is None
 
 
 def test_bad_moves_and_styles_raise():
