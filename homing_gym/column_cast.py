@@ -112,78 +112,94 @@ def _column_segment(p: np.ndarray, c: float, s: float):
     return True, a0, h0, a1, h1, w0, w1
 
 
-#: Largest tangent of a corner's bearing relative to the first corner that
-#: :func:`_span` bounds by the tangent itself instead of computing the angle.
-_SMALL_TANGENT = 0.05
 #: ``atan(a) = a * P(a**2)`` on ``[0, 1]``: a least-squares Chebyshev fit of degree 7
 #: in ``a**2``, within 2.9e-7 rad of the arctangent (tested).
 _ATAN_COEFFICIENTS = (0.9999999227737695, -0.3333223260372159, 0.19974028405362163,
                       -0.14047820368966144, 0.10002203051723593, -0.060874452164450414,
                       0.025331680256184555, -0.005021058164641616)
-#: How far (radians) :func:`_span` widens its interval beyond the approximate angles:
-#: more than the error of the approximate arctangent of two corners.
+#: How far (radians) :func:`triangle_spans` widens each interval beyond its approximate
+#: angles: more than the error of two approximate arctangents.
 _ATAN_SLACK = 1e-6
+#: How far (columns) an interval's columns are widened where they are found by
+#: arithmetic on evenly spaced bearings, beyond the rounding of that arithmetic.
+_INDEX_SLACK = 1e-6
+#: :func:`triangle_spans`' kinds of triangle.
+SKIP, SPAN, EVERYWHERE = 0, 1, 2
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _approx_atan2(y: float, x: float) -> float:
     """``atan2(y, x)`` to within 2.9e-7 rad (radians, in ``[-pi, pi]``), with one
-    division and a polynomial instead of the library's arctangent."""
+    division and a polynomial instead of the library's arctangent, and no branch (so
+    that a loop over many can be vectorised)."""
     ax, ay = abs(x), abs(y)
     big, small = max(ax, ay), min(ax, ay)
-    a = small / big if big > 0.0 else 0.0
+    a = small / (big if big > 0.0 else 1.0)
     z = a * a
     c = _ATAN_COEFFICIENTS
     r = a * (c[0] + z * (c[1] + z * (c[2] + z * (c[3] + z * (c[4] + z * (c[5] + z * (c[6]
                                                                                  + z * c[7])))))))
-    if ay > ax:
-        r = 0.5 * math.pi - r
-    if x < 0.0:
-        r = math.pi - r
+    r = 0.5 * math.pi - r if ay > ax else r
+    r = math.pi - r if x < 0.0 else r
     return -r if y < 0.0 else r
 
 
 @njit(cache=True, error_model="numpy")
-def _span(p: np.ndarray, yaw: float):
-    """Bearing span ``(lo, hi, everywhere)`` of the triangle's corners, relative to the
-    heading (radians, counter-clockwise; ``hi - lo < pi``), or an interval slightly
-    wider; ``everywhere`` when the camera's vertical line passes through the triangle.
-    ``lo > hi``: seen edge-on.
+def triangle_spans(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
+                   origin: np.ndarray, yaw: float, lo: np.ndarray, hi: np.ndarray,
+                   kind: np.ndarray) -> None:
+    """Which triangles the camera can see, and over which bearings.
 
-    A corner's bearing relative to the first corner is ``atan(t)`` for the tangent
-    ``t = cross / dot`` of their directions; where ``|t|`` is small (a triangle that
-    looks narrow, as most of a detailed world's do) the interval takes ``t`` itself,
-    which is farther from 0 than ``atan(t)`` (by less than ``t**3 / 3``, under 5e-5 rad).
-    Arctangents are approximate (:func:`_approx_atan2`) and the interval widened by
-    more than their error, :data:`_ATAN_SLACK`. So no column inside the span is
-    missed: the caster tests each column of the interval exactly anyway."""
-    c0 = p[0, 0] * p[1, 1] - p[0, 1] * p[1, 0]
-    c1 = p[1, 0] * p[2, 1] - p[1, 1] * p[2, 0]
-    c2 = p[2, 0] * p[0, 1] - p[2, 1] * p[0, 0]
-    if c0 == 0.0 and c1 == 0.0 and c2 == 0.0:
-        return 1.0, 0.0, False
-    if (c0 >= 0 and c1 >= 0 and c2 >= 0) or (c0 <= 0 and c1 <= 0 and c2 <= 0):
-        return -math.pi, math.pi, True
-    lo = hi = 0.0
-    for k in range(1, 3):
-        cross = p[0, 0] * p[k, 1] - p[0, 1] * p[k, 0]
-        dot = p[0, 0] * p[k, 0] + p[0, 1] * p[k, 1]
-        if dot > 0.0 and abs(cross) <= _SMALL_TANGENT * dot:
-            d = cross / dot
-        else:
-            d = _approx_atan2(cross, dot)
-        lo, hi = min(lo, d), max(hi, d)
-    a0 = _approx_atan2(p[0, 1], p[0, 0]) - yaw
-    return a0 + lo - _ATAN_SLACK, a0 + hi + _ATAN_SLACK, False
+    ``corners (9, N)``: the triangles' corners coordinate by coordinate (``x0, y0, z0,
+    x1, ...``, metres), ``normals (3, N)``, ``closed (N,)`` as in :func:`cast_columns`.
+    Writes ``kind[t]``: :data:`SKIP` (a closed solid's face turned away from the camera,
+    or one seen edge-on), :data:`EVERYWHERE` (the camera's vertical line passes through
+    it) or :data:`SPAN`, with ``[lo[t], hi[t]]`` holding the bearings of its corners
+    relative to the heading (radians, counter-clockwise; ``hi - lo < pi``), widened by
+    :data:`_ATAN_SLACK` beyond the error of the approximate arctangents, so that no
+    column the triangle reaches is missed: the caster tests each column exactly.
+    Branch-free per triangle, so that the loop is vectorised."""
+    ox, oy, oz = origin[0], origin[1], origin[2]
+    for t in range(corners.shape[1]):
+        x0, y0 = corners[0, t] - ox, corners[1, t] - oy
+        x1, y1 = corners[3, t] - ox, corners[4, t] - oy
+        x2, y2 = corners[6, t] - ox, corners[7, t] - oy
+        facing = (normals[0, t] * x0 + normals[1, t] * y0
+                  + normals[2, t] * (corners[2, t] - oz))
+        away = closed[t] & (facing >= 0.0)
+        c0, c1, c2 = x0 * y1 - y0 * x1, x1 * y2 - y1 * x2, x2 * y0 - y2 * x0
+        edge_on = (c0 == 0.0) & (c1 == 0.0) & (c2 == 0.0)
+        around = (((c0 >= 0.0) & (c1 >= 0.0) & (c2 >= 0.0))
+                  | ((c0 <= 0.0) & (c1 <= 0.0) & (c2 <= 0.0)))
+        d1 = _approx_atan2(x0 * y1 - y0 * x1, x0 * x1 + y0 * y1)
+        d2 = _approx_atan2(x0 * y2 - y0 * x2, x0 * x2 + y0 * y2)
+        a0 = _approx_atan2(y0, x0) - yaw
+        lo[t] = a0 + min(min(d1, d2), 0.0) - _ATAN_SLACK
+        hi[t] = a0 + max(max(d1, d2), 0.0) + _ATAN_SLACK
+        kind[t] = (SPAN + around) * (1 - (away | edge_on))
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _columns(beta: np.ndarray, lo: float, hi: float, per_radian: float):
+    """``(j0, j1)``: the columns ``j0 <= j < j1`` whose bearing lies in ``[lo, hi]``
+    (a little wider), empty when none does."""
+    W = beta.shape[0]
+    if hi + 1e-12 <= beta[W - 1] or lo - 1e-12 > beta[0]:
+        return 0, 0
+    j0 = _first_past(beta, hi + 1e-12, True, int(max((beta[0] - hi) * per_radian, 0.0)))
+    j1 = _first_past(beta, lo - 1e-12, True, int(max((beta[0] - lo) * per_radian, 0.0)))
+    return j0, j1
 
 
 @njit(cache=True, error_model="numpy")
-def cast_columns(tris: np.ndarray, normals: np.ndarray, closed: np.ndarray,
-                 origin: np.ndarray, yaw: float, beta: np.ndarray, tan_elev: np.ndarray,
-                 hit: np.ndarray, weights: np.ndarray, depth: np.ndarray) -> None:
+def cast_columns(tris: np.ndarray, corners: np.ndarray, normals: np.ndarray,
+                 closed: np.ndarray, origin: np.ndarray, yaw: float, beta: np.ndarray,
+                 tan_elev: np.ndarray, hit: np.ndarray, weights: np.ndarray,
+                 depth: np.ndarray) -> None:
     """Nearest triangle per pixel.
 
-    ``tris (N, 3, 3)`` world corners (metres); ``normals (N, 3)`` their normals;
+    ``tris (N, 3, 3)`` world corners (metres), also as ``corners (9, N)`` (coordinate
+    by coordinate: ``x0, y0, z0, x1, ...``); ``normals (3, N)`` their normals;
     ``closed (N,)``: the triangle bounds a closed solid and its normal points out, so
     it is skipped when turned away from the camera (hidden by the solid's near side
     whenever the camera is outside the solid); ``origin (3,)`` the camera; ``yaw`` its
@@ -193,42 +209,49 @@ def cast_columns(tris: np.ndarray, normals: np.ndarray, closed: np.ndarray,
     (``-1``: nothing) and ``weights (H, W, 3)`` the barycentric weights of the hit;
     ``depth (W, H)`` is scratch (the nearest hit's horizontal distance so far, column by
     column like the loops below), overwritten.
+
+    The triangles' bearing spans come first, all at once (:func:`triangle_spans`);
+    where the columns go once round the circle at even steps (a panorama) a span's
+    columns are found by arithmetic, else by searching ``beta``.
     """
     H, W = tan_elev.shape
+    N = tris.shape[0]
     depth[:] = np.inf
     hit[:] = -1
     cos_b = np.cos(yaw + beta)
     sin_b = np.sin(yaw + beta)
     # columns per radian if evenly spaced: where the searches for a bearing start
     per_radian = (W - 1) / (beta[0] - beta[W - 1]) if W > 1 else 0.0
+    step = 2 * math.pi / W
+    circle = W > 1 and abs(beta[0] - beta[W - 1] - (W - 1) * step) < 1e-9
+    for j in range(1, W):
+        circle = circle and abs(beta[j - 1] - beta[j] - step) < 1e-9
     # rows per unit of tangent if evenly spaced in tangent: where the row searches start
     rows_per_tan = (H - 1) / (tan_elev[0] - tan_elev[H - 1] + 1e-300)
+    lo, hi, kind = np.empty(N), np.empty(N), np.empty(N, np.int8)
+    triangle_spans(corners, normals, closed, origin, yaw, lo, hi, kind)
     p = np.empty((3, 3))
-    for t in range(tris.shape[0]):
-        if closed[t] and (normals[t, 0] * (tris[t, 0, 0] - origin[0])
-                          + normals[t, 1] * (tris[t, 0, 1] - origin[1])
-                          + normals[t, 2] * (tris[t, 0, 2] - origin[2])) >= 0.0:
+    for t in range(N):
+        if kind[t] == SKIP:
             continue
         for k in range(3):
             for d in range(3):
                 p[k, d] = tris[t, k, d] - origin[d]
-        lo, hi, everywhere = _span(p, yaw)
-        if lo > hi:
-            continue
         for shift in (-2 * math.pi, 0.0, 2 * math.pi):
-            if everywhere and shift != 0.0:
-                continue
-            if not everywhere and (hi + shift + 1e-12 <= beta[W - 1]
-                                   or lo + shift - 1e-12 > beta[0]):
-                continue          # no column in this turn of the span: skip the searches
-            j0, j1 = 0, W
-            if not everywhere:
-                j0 = _first_past(beta, hi + shift + 1e-12, True,
-                                 int(max((beta[0] - hi - shift) * per_radian, 0.0)))
-                j1 = _first_past(beta, lo + shift - 1e-12, True,
-                                 int(max((beta[0] - lo - shift) * per_radian, 0.0)))
+            if kind[t] == EVERYWHERE:
+                if shift != 0.0:
+                    continue
+                j0, j1 = 0, W
+            elif circle:             # once round: columns by arithmetic, wrapped below
+                if shift != 0.0:
+                    continue
+                j0 = int(math.ceil((beta[0] - hi[t]) / step - _INDEX_SLACK))
+                j1 = int(math.floor((beta[0] - lo[t]) / step + _INDEX_SLACK)) + 1
+            else:
+                j0, j1 = _columns(beta, lo[t] + shift, hi[t] + shift, per_radian)
             i0 = -1                  # the row where the previous column's segment began
-            for j in range(j0, j1):
+            for jj in range(j0, j1):
+                j = jj + W if jj < 0 else (jj - W if jj >= W else jj)   # no division
                 ok, a0, h0, a1, h1, (w0, w1, w2), (v0, v1, v2) = _column_segment(
                     p, cos_b[j], sin_b[j])
                 if not ok:

@@ -119,6 +119,10 @@ class RayCaster:
         self._tris = mesh.triangles.astype(np.float64)
         self._normals = mesh.normals.astype(np.float64)
         self._closed = mesh.closed.astype(np.bool_)
+        #: The corners and normals coordinate by coordinate, for the caster's span pass,
+        #: in the mesh's float32 (exact: half the memory to read for every image).
+        self._corners = np.ascontiguousarray(mesh.triangles.reshape(-1, 9).T, np.float32)
+        self._normals_by_axis = np.ascontiguousarray(mesh.normals.T, np.float32)
         self._uvs = mesh.uvs.astype(np.float64)
         self._texture = mesh.texture.astype(np.int64)
         pyramids = [mip_levels(t) for t in mesh.textures]
@@ -178,8 +182,8 @@ class RayCaster:
         H, W = tan_elev.shape
         hit, weights, depth = self._buffers(H, W)
         origin = np.array([x, y, camera_height])
-        cast_columns(self._tris, self._normals, self._closed, origin, yaw, beta, tan_elev,
-                     hit, weights, depth)
+        cast_columns(self._tris, self._corners, self._normals_by_axis, self._closed, origin,
+                     yaw, beta, tan_elev, hit, weights, depth)
         image = np.empty((H // k, W // k, 3), np.uint8)
         light = lighting or DEFAULT_LIGHTING
         shadow = self._shadow_map(light) if self.shadows else _NO_SHADOWS

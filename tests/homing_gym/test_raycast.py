@@ -176,8 +176,8 @@ def test_every_pixel_hits_what_embree_hits(scene):
                           perspective_rays(160, 120, 140.0)):
             H, W = tan.shape
             hit, weights = np.empty((H, W), np.int64), np.empty((H, W, 3))
-            cast_columns(tris, mesh.normals.astype(np.float64), mesh.closed, origin, yaw,
-                         beta, tan, hit, weights, np.empty((W, H)))
+            cast_columns(tris, tris.reshape(-1, 9).T.copy(), mesh.normals.T.copy(),
+                         mesh.closed, origin, yaw, beta, tan, hit, weights, np.empty((W, H)))
             cos_e = 1 / np.sqrt(1 + tan ** 2)
             dirs = np.stack([cos_e * np.cos(yaw + beta), cos_e * np.sin(yaw + beta),
                              cos_e * tan], -1).reshape(-1, 3).astype(np.float32)
