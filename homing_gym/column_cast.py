@@ -66,50 +66,59 @@ def _first_past(values: np.ndarray, value: float, strict: bool, guess: int) -> i
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _column_segment(p: np.ndarray, c: float, s: float):
-    """The triangle ``p`` (corners relative to the camera) cut by the vertical plane of
-    horizontal direction ``(c, s)``, clipped to the half-plane in front: ``(ok, a0, h0,
-    a1, h1, w0, w1)``, its two ends' distance along the plane and height (metres) and
-    barycentric weights (tuples of 3). ``ok`` False when the triangle misses the
-    half-plane. The ends follow the triangle's edges in order (0-1, 1-2, 2-0): the
-    corner alone on its side of the plane is the one both cut edges share."""
-    d0 = -s * p[0, 0] + c * p[0, 1]
-    d1 = -s * p[1, 0] + c * p[1, 1]
-    d2 = -s * p[2, 0] + c * p[2, 1]
+def _edge_cut(c: float, s: float, dk: float, dm: float, xk: float, yk: float, zk: float,
+              xm: float, ym: float, zm: float):
+    """Where the edge from corner ``k`` to corner ``m`` (relative to the camera; ``dk``,
+    ``dm`` their signed distances from the plane) crosses the vertical plane of
+    horizontal direction ``(c, s)``: ``(u, along, height)``, ``u`` the fraction of the
+    way from ``k``."""
+    u = dk / (dk - dm)
+    return u, (1 - u) * (c * xk + s * yk) + u * (c * xm + s * ym), (1 - u) * zk + u * zm
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _column_segment(x0: float, y0: float, z0: float, x1: float, y1: float, z1: float,
+                    x2: float, y2: float, z2: float, c: float, s: float):
+    """The triangle with corners ``(x0, y0, z0)``, ... (relative to the camera) cut by
+    the vertical plane of horizontal direction ``(c, s)``, clipped to the half-plane in
+    front: ``(ok, a0, h0, a1, h1, w0, w1)``, its two ends' distance along the plane
+    and height (metres) and barycentric weights (tuples of 3); ``ok`` False when the
+    triangle misses the half-plane. The ends follow the triangle's edges in order (0-1,
+    1-2, 2-0): the corner alone on its side of the plane is the one both cut edges
+    share. All three edges are cut and the two crossing ones picked, with no branch,
+    so that a loop over many is vectorised."""
+    d0, d1, d2 = -s * x0 + c * y0, -s * x1 + c * y1, -s * x2 + c * y2
     b0, b1, b2 = d0 >= 0.0, d1 >= 0.0, d2 >= 0.0
-    none = (False, 0.0, 0.0, 0.0, 0.0, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
-    if b0 == b1 == b2:
-        return none
-    # the cut edges (k, m), in edge order, and the corner left out by each
-    if b0 == b1:                      # corner 2 alone: edges 1-2, 2-0
-        k1, m1, k2, m2, dk1, dm1, dk2, dm2 = 1, 2, 2, 0, d1, d2, d2, d0
-    elif b0 == b2:                    # corner 1 alone: edges 0-1, 1-2
-        k1, m1, k2, m2, dk1, dm1, dk2, dm2 = 0, 1, 1, 2, d0, d1, d1, d2
-    else:                             # corner 0 alone: edges 0-1, 2-0
-        k1, m1, k2, m2, dk1, dm1, dk2, dm2 = 0, 1, 2, 0, d0, d1, d2, d0
-    u = dk1 / (dk1 - dm1)
-    a0 = (1 - u) * (c * p[k1, 0] + s * p[k1, 1]) + u * (c * p[m1, 0] + s * p[m1, 1])
-    h0 = (1 - u) * p[k1, 2] + u * p[m1, 2]
-    w0 = (1 - u if k1 == 0 else 0.0, u if m1 == 1 else (1 - u if k1 == 1 else 0.0),
-          u if m1 == 2 else 0.0)
-    v = dk2 / (dk2 - dm2)
-    a1 = (1 - v) * (c * p[k2, 0] + s * p[k2, 1]) + v * (c * p[m2, 0] + s * p[m2, 1])
-    h1 = (1 - v) * p[k2, 2] + v * p[m2, 2]
-    w1 = (v if m2 == 0 else 0.0, 1 - v if k2 == 1 else 0.0,
-          (1 - v if k2 == 2 else (v if m2 == 2 else 0.0)))
-    if a0 < NEAR and a1 < NEAR:
-        return none
-    if a0 < NEAR:                     # move an end behind the camera to just in front
-        t = (NEAR - a0) / (a1 - a0)
-        a0, h0 = a0 + t * (a1 - a0), h0 + t * (h1 - h0)
-        w0 = (w0[0] + t * (w1[0] - w0[0]), w0[1] + t * (w1[1] - w0[1]),
-              w0[2] + t * (w1[2] - w0[2]))
-    if a1 < NEAR:
-        t = (NEAR - a1) / (a0 - a1)
-        a1, h1 = a1 + t * (a0 - a1), h1 + t * (h0 - h1)
-        w1 = (w1[0] + t * (w0[0] - w1[0]), w1[1] + t * (w0[1] - w1[1]),
-              w1[2] + t * (w0[2] - w1[2]))
-    return True, a0, h0, a1, h1, w0, w1
+    alone2 = b0 == b1                                  # edges 1-2, 2-0
+    alone1 = (b0 == b2) & ~alone2                      # edges 0-1, 1-2
+    u01, a01, h01 = _edge_cut(c, s, d0, d1, x0, y0, z0, x1, y1, z1)
+    u12, a12, h12 = _edge_cut(c, s, d1, d2, x1, y1, z1, x2, y2, z2)
+    u20, a20, h20 = _edge_cut(c, s, d2, d0, x2, y2, z2, x0, y0, z0)
+    a0 = a12 if alone2 else a01
+    h0 = h12 if alone2 else h01
+    w00 = 0.0 if alone2 else 1 - u01
+    w01 = 1 - u12 if alone2 else u01
+    w02 = u12 if alone2 else 0.0
+    a1 = a12 if alone1 else a20
+    h1 = h12 if alone1 else h20
+    w10 = 0.0 if alone1 else u20
+    w11 = 1 - u12 if alone1 else 0.0
+    w12 = u12 if alone1 else 1 - u20
+    ok = ~((b0 == b1) & (b1 == b2)) & ((a0 >= NEAR) | (a1 >= NEAR))
+    # an end behind the camera moves to just in front of it
+    f = (NEAR - a0) / (a1 - a0)
+    behind = a0 < NEAR
+    a0, h0 = (a0 + f * (a1 - a0) if behind else a0), (h0 + f * (h1 - h0) if behind else h0)
+    w00 = w00 + f * (w10 - w00) if behind else w00
+    w01 = w01 + f * (w11 - w01) if behind else w01
+    w02 = w02 + f * (w12 - w02) if behind else w02
+    f = (NEAR - a1) / (a0 - a1)
+    behind = a1 < NEAR
+    a1, h1 = (a1 + f * (a0 - a1) if behind else a1), (h1 + f * (h0 - h1) if behind else h1)
+    w10 = w10 + f * (w00 - w10) if behind else w10
+    w11 = w11 + f * (w01 - w11) if behind else w11
+    w12 = w12 + f * (w02 - w12) if behind else w12
+    return ok, a0, h0, a1, h1, (w00, w01, w02), (w10, w11, w12)
 
 
 #: ``atan(a) = a * P(a**2)`` on ``[0, 1]``: a least-squares Chebyshev fit of degree 7
@@ -191,31 +200,103 @@ def _columns(beta: np.ndarray, lo: float, hi: float, per_radian: float):
     return j0, j1
 
 
+#: Triangle-column pairs cut at once by :func:`_cut_columns` (its buffers stay in the
+#: first-level cache).
+CHUNK = 256
+#: Rows of the pairs :func:`_cut_columns` reads after the 9 corners (relative to the
+#: camera): the column's horizontal direction, its first row's elevation (radians) and
+#: rows per radian if they were evenly spaced.
+_COS, _SIN, _TOP_ANGLE, _ROWS_PER_RADIAN = 9, 10, 11, 12
+#: Rows of :func:`_cut_columns`' output.
+_OK, _A0, _H0, _A1, _H1, _W00, _W01, _W02, _W10, _W11, _W12, _TOP, _LOW, _GUESS = range(14)
+
+
 @njit(cache=True, error_model="numpy")
-def cast_columns(tris: np.ndarray, corners: np.ndarray, normals: np.ndarray,
-                 closed: np.ndarray, origin: np.ndarray, yaw: float, beta: np.ndarray,
-                 tan_elev: np.ndarray, hit: np.ndarray, weights: np.ndarray,
-                 depth: np.ndarray) -> None:
+def _cut_columns(n: int, p: np.ndarray, H: int, out: np.ndarray) -> None:
+    """For the first ``n`` pairs ``p[:, k]`` (:func:`cast_columns`): the triangle cut
+    by the plane of the column (:func:`_column_segment`), the tangents of the
+    elevations of the segment's ends (``_TOP``, ``_LOW``), and a guess of the first row
+    at or below the upper one, as if rows were evenly spaced in elevation. Branch-free,
+    and with the rows of ``p`` and ``out`` at constant distances in flat arrays (so
+    that the compiler sees they cannot overlap): vectorised."""
+    C = CHUNK
+    for k in range(n):
+        ok, a0, h0, a1, h1, w0, w1 = _column_segment(
+            p[k], p[C + k], p[2 * C + k], p[3 * C + k], p[4 * C + k], p[5 * C + k],
+            p[6 * C + k], p[7 * C + k], p[8 * C + k], p[_COS * C + k], p[_SIN * C + k])
+        ta, tb = h0 / a0, h1 / a1
+        top = max(ta, tb)
+        guess = (p[_TOP_ANGLE * C + k] - _approx_atan2(top, 1.0)) * p[_ROWS_PER_RADIAN * C + k]
+        out[_OK * C + k] = 1.0 if ok else 0.0
+        out[_A0 * C + k], out[_H0 * C + k], out[_A1 * C + k], out[_H1 * C + k] = a0, h0, a1, h1
+        out[_W00 * C + k], out[_W01 * C + k], out[_W02 * C + k] = w0
+        out[_W10 * C + k], out[_W11 * C + k], out[_W12 * C + k] = w1
+        out[_TOP * C + k], out[_LOW * C + k] = top, min(ta, tb)
+        out[_GUESS * C + k] = min(max(guess, 0.0), float(H))
+
+
+@njit(cache=True, error_model="numpy")
+def _fill_rows(n: int, triangle: np.ndarray, column: np.ndarray, cut: np.ndarray,
+               tan_elev: np.ndarray, hit: np.ndarray, weights: np.ndarray,
+               depth: np.ndarray) -> None:
+    """The rows of the first ``n`` cut pairs (:func:`_cut_columns`): each ray of the
+    column between the segment's ends hits it at a distance found in closed form; the
+    nearest hit so far per pixel wins."""
+    H, C = tan_elev.shape[0], CHUNK
+    for k in range(n):
+        if cut[_OK * C + k] == 0.0:
+            continue
+        t, j = triangle[k], column[k]
+        a0, h0, a1, h1 = cut[_A0 * C + k], cut[_H0 * C + k], cut[_A1 * C + k], cut[_H1 * C + k]
+        w0, w1, w2 = cut[_W00 * C + k], cut[_W01 * C + k], cut[_W02 * C + k]
+        da = a1 - a0
+        dw0, dw1, dw2 = cut[_W10 * C + k] - w0, cut[_W11 * C + k] - w1, cut[_W12 * C + k] - w2
+        lowest = cut[_LOW * C + k]
+        first = _first_past(tan_elev[:, j], cut[_TOP * C + k], False, int(cut[_GUESS * C + k]))
+        for i in range(first, H):
+            ti = tan_elev[i, j]
+            if ti < lowest:
+                break
+            fa = h0 - ti * a0
+            fb = h1 - ti * a1
+            if fa == fb:
+                continue
+            u = min(max(fa / (fa - fb), 0.0), 1.0)
+            dist = a0 + u * da
+            if dist < depth[j, i]:
+                depth[j, i] = dist
+                hit[i, j] = t
+                weights[i, j, 0] = w0 + u * dw0
+                weights[i, j, 1] = w1 + u * dw1
+                weights[i, j, 2] = w2 + u * dw2
+
+
+@njit(cache=True, error_model="numpy")
+def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
+                 origin: np.ndarray, yaw: float, beta: np.ndarray, tan_elev: np.ndarray,
+                 hit: np.ndarray, weights: np.ndarray, depth: np.ndarray) -> None:
     """Nearest triangle per pixel.
 
-    ``tris (N, 3, 3)`` world corners (metres), also as ``corners (9, N)`` (coordinate
-    by coordinate: ``x0, y0, z0, x1, ...``); ``normals (3, N)`` their normals;
-    ``closed (N,)``: the triangle bounds a closed solid and its normal points out, so
-    it is skipped when turned away from the camera (hidden by the solid's near side
-    whenever the camera is outside the solid); ``origin (3,)`` the camera; ``yaw`` its
-    heading (radians); ``beta (W,)`` column bearings relative to the heading, strictly
-    descending within ``(-pi, pi]``; ``tan_elev (H, W)`` tangent of each pixel's ray
-    elevation, descending down each column. Writes ``hit (H, W)`` the triangle index
-    (``-1``: nothing) and ``weights (H, W, 3)`` the barycentric weights of the hit;
-    ``depth (W, H)`` is scratch (the nearest hit's horizontal distance so far, column by
-    column like the loops below), overwritten.
+    ``corners (9, N)``: the triangles' world corners coordinate by coordinate (``x0,
+    y0, z0, x1, ...``, metres); ``normals (3, N)`` their normals; ``closed (N,)``: the
+    triangle bounds a closed solid and its normal points out, so it is skipped when
+    turned away from the camera (hidden by the solid's near side whenever the camera is
+    outside the solid); ``origin (3,)`` the camera; ``yaw`` its heading (radians);
+    ``beta (W,)`` column bearings relative to the heading, strictly descending within
+    ``(-pi, pi]``; ``tan_elev (H, W)`` tangent of each pixel's ray elevation,
+    descending down each column. Writes ``hit (H, W)`` the triangle index (``-1``:
+    nothing) and ``weights (H, W, 3)`` the barycentric weights of the hit; ``depth (W,
+    H)`` is scratch (the nearest hit's horizontal distance so far, column by column
+    like the loops below), overwritten.
 
-    The triangles' bearing spans come first, all at once (:func:`triangle_spans`);
-    where the columns go once round the circle at even steps (a panorama) a span's
-    columns are found by arithmetic, else by searching ``beta``.
+    Three passes: the triangles' bearing spans, all at once (:func:`triangle_spans`);
+    the pairs of a triangle and a column in its span, cut :data:`CHUNK` at a time
+    (:func:`_cut_columns`); then their rows (:func:`_fill_rows`), in the order of the
+    triangles. Where the columns go once round the circle at even steps (a panorama)
+    a span's columns are found by arithmetic, else by searching ``beta``.
     """
     H, W = tan_elev.shape
-    N = tris.shape[0]
+    N = corners.shape[1]
     depth[:] = np.inf
     hit[:] = -1
     cos_b = np.cos(yaw + beta)
@@ -223,20 +304,23 @@ def cast_columns(tris: np.ndarray, corners: np.ndarray, normals: np.ndarray,
     # columns per radian if evenly spaced: where the searches for a bearing start
     per_radian = (W - 1) / (beta[0] - beta[W - 1]) if W > 1 else 0.0
     step = 2 * math.pi / W
-    circle = W > 1 and abs(beta[0] - beta[W - 1] - (W - 1) * step) < 1e-9
+    circle = W > 1
     for j in range(1, W):
         circle = circle and abs(beta[j - 1] - beta[j] - step) < 1e-9
-    # rows per unit of tangent if evenly spaced in tangent: where the row searches start
-    rows_per_tan = (H - 1) / (tan_elev[0] - tan_elev[H - 1] + 1e-300)
+    top_angle, rows_per_radian = np.empty(W), np.empty(W)
+    for j in range(W):
+        top_angle[j] = _approx_atan2(tan_elev[0, j], 1.0)
+        span = top_angle[j] - _approx_atan2(tan_elev[H - 1, j], 1.0)
+        rows_per_radian[j] = (H - 1) / span if span > 0.0 else 0.0
     lo, hi, kind = np.empty(N), np.empty(N), np.empty(N, np.int8)
     triangle_spans(corners, normals, closed, origin, yaw, lo, hi, kind)
-    p = np.empty((3, 3))
+    p = np.empty(13 * CHUNK)
+    triangle, column = np.empty(CHUNK, np.int64), np.empty(CHUNK, np.int64)
+    cut = np.empty(14 * CHUNK)
+    n = 0
     for t in range(N):
         if kind[t] == SKIP:
             continue
-        for k in range(3):
-            for d in range(3):
-                p[k, d] = tris[t, k, d] - origin[d]
         for shift in (-2 * math.pi, 0.0, 2 * math.pi):
             if kind[t] == EVERYWHERE:
                 if shift != 0.0:
@@ -249,36 +333,21 @@ def cast_columns(tris: np.ndarray, corners: np.ndarray, normals: np.ndarray,
                 j1 = int(math.floor((beta[0] - lo[t]) / step + _INDEX_SLACK)) + 1
             else:
                 j0, j1 = _columns(beta, lo[t] + shift, hi[t] + shift, per_radian)
-            i0 = -1                  # the row where the previous column's segment began
             for jj in range(j0, j1):
-                j = jj + W if jj < 0 else (jj - W if jj >= W else jj)   # no division
-                ok, a0, h0, a1, h1, (w0, w1, w2), (v0, v1, v2) = _column_segment(
-                    p, cos_b[j], sin_b[j])
-                if not ok:
-                    continue
-                da, dw0, dw1, dw2 = a1 - a0, v0 - w0, v1 - w1, v2 - w2
-                ta, tb = h0 / a0, h1 / a1
-                lowest = min(ta, tb)
-                top = max(ta, tb)
-                if i0 < 0:           # a triangle's first column: guess as if tangents were even
-                    i0 = int(min(max((tan_elev[0, j] - top) * rows_per_tan[j], 0.0), H))
-                i0 = _first_past(tan_elev[:, j], top, False, i0)
-                for i in range(i0, H):
-                    ti = tan_elev[i, j]
-                    if ti < lowest:
-                        break
-                    fa = h0 - ti * a0
-                    fb = h1 - ti * a1
-                    if fa == fb:
-                        continue
-                    u = min(max(fa / (fa - fb), 0.0), 1.0)
-                    dist = a0 + u * da
-                    if dist < depth[j, i]:
-                        depth[j, i] = dist
-                        hit[i, j] = t
-                        weights[i, j, 0] = w0 + u * dw0
-                        weights[i, j, 1] = w1 + u * dw1
-                        weights[i, j, 2] = w2 + u * dw2
+                for d in range(9):
+                    p[d * CHUNK + n] = corners[d, t] - origin[d % 3]
+                j = jj + W if jj < 0 else (jj - W if jj >= W else jj)
+                p[_COS * CHUNK + n], p[_SIN * CHUNK + n] = cos_b[j], sin_b[j]
+                p[_TOP_ANGLE * CHUNK + n] = top_angle[j]
+                p[_ROWS_PER_RADIAN * CHUNK + n] = rows_per_radian[j]
+                triangle[n], column[n] = t, j
+                n += 1
+                if n == CHUNK:
+                    _cut_columns(n, p, H, cut)
+                    _fill_rows(n, triangle, column, cut, tan_elev, hit, weights, depth)
+                    n = 0
+    _cut_columns(n, p, H, cut)
+    _fill_rows(n, triangle, column, cut, tan_elev, hit, weights, depth)
 
 
 @njit(cache=True, error_model="numpy", inline="always")

@@ -182,8 +182,8 @@ class RayCaster:
         H, W = tan_elev.shape
         hit, weights, depth = self._buffers(H, W)
         origin = np.array([x, y, camera_height])
-        cast_columns(self._tris, self._corners, self._normals_by_axis, self._closed, origin,
-                     yaw, beta, tan_elev, hit, weights, depth)
+        cast_columns(self._corners, self._normals_by_axis, self._closed, origin, yaw, beta,
+                     tan_elev, hit, weights, depth)
         image = np.empty((H // k, W // k, 3), np.uint8)
         light = lighting or DEFAULT_LIGHTING
         shadow = self._shadow_map(light) if self.shadows else _NO_SHADOWS

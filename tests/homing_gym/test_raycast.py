@@ -176,7 +176,7 @@ def test_every_pixel_hits_what_embree_hits(scene):
                           perspective_rays(160, 120, 140.0)):
             H, W = tan.shape
             hit, weights = np.empty((H, W), np.int64), np.empty((H, W, 3))
-            cast_columns(tris, tris.reshape(-1, 9).T.copy(), mesh.normals.T.copy(),
+            cast_columns(tris.reshape(-1, 9).T.copy(), mesh.normals.T.copy(),
                          mesh.closed, origin, yaw, beta, tan, hit, weights, np.empty((W, H)))
             cos_e = 1 / np.sqrt(1 + tan ** 2)
             dirs = np.stack([cos_e * np.cos(yaw + beta), cos_e * np.sin(yaw + beta),
