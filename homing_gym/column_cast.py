@@ -252,7 +252,12 @@ def _fill_rows(n: int, triangle: np.ndarray, column: np.ndarray, cut: np.ndarray
         da = a1 - a0
         dw0, dw1, dw2 = cut[_W10 * C + k] - w0, cut[_W11 * C + k] - w1, cut[_W12 * C + k] - w2
         lowest = cut[_LOW * C + k]
-        first = _first_past(tan_elev[:, j], cut[_TOP * C + k], False, int(cut[_GUESS * C + k]))
+        # the first row at or below the segment's top: walked to from the guess
+        top, first = cut[_TOP * C + k], int(cut[_GUESS * C + k])
+        while first > 0 and tan_elev[first - 1, j] <= top:
+            first -= 1
+        while first < H and tan_elev[first, j] > top:
+            first += 1
         for i in range(first, H):
             ti = tan_elev[i, j]
             if ti < lowest:
@@ -314,29 +319,28 @@ def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
         rows_per_radian[j] = (H - 1) / span if span > 0.0 else 0.0
     lo, hi, kind = np.empty(N), np.empty(N), np.empty(N, np.int8)
     triangle_spans(corners, normals, closed, origin, yaw, lo, hi, kind)
+    ranges = np.zeros((4, N), np.int64)          # (first, count) of up to two column runs
+    if circle:
+        _circle_columns(lo, hi, kind, beta[0], step, W, ranges)
+    else:
+        _searched_columns(lo, hi, kind, beta, per_radian, ranges)
     p = np.empty(13 * CHUNK)
     triangle, column = np.empty(CHUNK, np.int64), np.empty(CHUNK, np.int64)
     cut = np.empty(14 * CHUNK)
     n = 0
+    ox, oy, oz = origin[0], origin[1], origin[2]
     for t in range(N):
-        if kind[t] == SKIP:
+        if ranges[1, t] == 0:
             continue
-        for shift in (-2 * math.pi, 0.0, 2 * math.pi):
-            if kind[t] == EVERYWHERE:
-                if shift != 0.0:
-                    continue
-                j0, j1 = 0, W
-            elif circle:             # once round: columns by arithmetic, wrapped below
-                if shift != 0.0:
-                    continue
-                j0 = int(math.ceil((beta[0] - hi[t]) / step - _INDEX_SLACK))
-                j1 = int(math.floor((beta[0] - lo[t]) / step + _INDEX_SLACK)) + 1
-            else:
-                j0, j1 = _columns(beta, lo[t] + shift, hi[t] + shift, per_radian)
-            for jj in range(j0, j1):
-                for d in range(9):
-                    p[d * CHUNK + n] = corners[d, t] - origin[d % 3]
+        x0, y0, z0 = corners[0, t] - ox, corners[1, t] - oy, corners[2, t] - oz
+        x1, y1, z1 = corners[3, t] - ox, corners[4, t] - oy, corners[5, t] - oz
+        x2, y2, z2 = corners[6, t] - ox, corners[7, t] - oy, corners[8, t] - oz
+        for r in range(0, 4, 2):
+            for jj in range(ranges[r, t], ranges[r, t] + ranges[r + 1, t]):
                 j = jj + W if jj < 0 else (jj - W if jj >= W else jj)
+                p[n], p[CHUNK + n], p[2 * CHUNK + n] = x0, y0, z0
+                p[3 * CHUNK + n], p[4 * CHUNK + n], p[5 * CHUNK + n] = x1, y1, z1
+                p[6 * CHUNK + n], p[7 * CHUNK + n], p[8 * CHUNK + n] = x2, y2, z2
                 p[_COS * CHUNK + n], p[_SIN * CHUNK + n] = cos_b[j], sin_b[j]
                 p[_TOP_ANGLE * CHUNK + n] = top_angle[j]
                 p[_ROWS_PER_RADIAN * CHUNK + n] = rows_per_radian[j]
@@ -348,6 +352,41 @@ def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
                     n = 0
     _cut_columns(n, p, H, cut)
     _fill_rows(n, triangle, column, cut, tan_elev, hit, weights, depth)
+
+
+@njit(cache=True, error_model="numpy")
+def _circle_columns(lo: np.ndarray, hi: np.ndarray, kind: np.ndarray, first: float,
+                    step: float, W: int, ranges: np.ndarray) -> None:
+    """``ranges[0:2, t]``: the first column (unwrapped: may lie outside ``[0, W)``) and
+    the number of columns of each triangle's span, for ``W`` columns once round the
+    circle at bearings ``first - j * step``; a little wider than the span (each column
+    is tested exactly). Branch-free: vectorised."""
+    for t in range(lo.shape[0]):
+        j0 = int(math.ceil((first - hi[t]) / step - _INDEX_SLACK))
+        j1 = int(math.floor((first - lo[t]) / step + _INDEX_SLACK)) + 1
+        everywhere = kind[t] == EVERYWHERE
+        ranges[0, t] = 0 if everywhere else j0
+        ranges[1, t] = W if everywhere else (0 if kind[t] == SKIP else max(j1 - j0, 0))
+
+
+@njit(cache=True, error_model="numpy")
+def _searched_columns(lo: np.ndarray, hi: np.ndarray, kind: np.ndarray, beta: np.ndarray,
+                      per_radian: float, ranges: np.ndarray) -> None:
+    """``ranges[:, t]``: ``(first, count)`` of up to two runs of the columns ``beta``
+    (any bearings, strictly descending) in each triangle's span, found by search."""
+    W = beta.shape[0]
+    for t in range(lo.shape[0]):
+        if kind[t] == EVERYWHERE:
+            ranges[0, t], ranges[1, t] = 0, W
+            continue
+        if kind[t] == SKIP:
+            continue
+        r = 0
+        for shift in (-2 * math.pi, 0.0, 2 * math.pi):
+            j0, j1 = _columns(beta, lo[t] + shift, hi[t] + shift, per_radian)
+            if j1 > j0 and r < 4:
+                ranges[r, t], ranges[r + 1, t] = j0, j1 - j0
+                r += 2
 
 
 @njit(cache=True, error_model="numpy", inline="always")
