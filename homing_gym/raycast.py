@@ -125,6 +125,9 @@ class RayCaster:
         self._normals_by_axis = np.ascontiguousarray(mesh.normals.T, np.float32)
         self._uvs = mesh.uvs.astype(np.float64)
         self._texture = mesh.texture.astype(np.int64)
+        #: Triangles whose hits need barycentric weights (a texture; with shadows, all).
+        self._textured = self._texture >= 0
+        self._everywhere = np.ones(len(self._texture), np.bool_)
         pyramids = [mip_levels(t) for t in mesh.textures]
         images = [level for pyramid in pyramids for level in pyramid]
         offsets = np.concatenate([[0], np.cumsum([i.size for i in images])[:-1]]).astype(np.int64)
@@ -175,15 +178,16 @@ class RayCaster:
                                      np.empty((W, H)))
         return self._scratch[(H, W)]
 
-    def _image(self, pose, camera_height: float, rays, k: int, spacing: float,
-               lighting: Lighting | None) -> np.ndarray:
+    def _image(self, pose, camera_height: float, rays, even_rows: bool, k: int,
+               spacing: float, lighting: Lighting | None) -> np.ndarray:
         beta, tan_elev = rays
         x, y, yaw = (float(v) for v in pose)
         H, W = tan_elev.shape
         hit, weights, depth = self._buffers(H, W)
         origin = np.array([x, y, camera_height])
+        weighted = self._everywhere if self.shadows else self._textured
         cast_columns(self._corners, self._normals_by_axis, self._closed, origin, yaw, beta,
-                     tan_elev, hit, weights, depth)
+                     tan_elev, even_rows, weighted, hit, weights, depth)
         image = np.empty((H // k, W // k, 3), np.uint8)
         light = lighting or DEFAULT_LIGHTING
         shadow = self._shadow_map(light) if self.shadows else _NO_SHADOWS
@@ -203,10 +207,11 @@ class RayCaster:
         rays = panorama_rays((H, W), config.vfov, k)
         # each ray filters the texture over a whole pixel (see :func:`shade`'s caller note)
         spacing = max(2 * np.pi / W, config.vfov / H)
-        return self._image(pose, camera_height, rays, k, spacing, lighting)
+        return self._image(pose, camera_height, rays, True, k, spacing, lighting)
 
     def perspective(self, pose, camera_height: float, width: int, height: int, focal: float,
                     lighting: Lighting | None = None, supersampling: int = 1) -> np.ndarray:
         """A pinhole view (uint8 ``(height, width, 3)``) along the heading at ``pose``."""
         rays = perspective_rays(width, height, float(focal), supersampling)
-        return self._image(pose, camera_height, rays, supersampling, 1.0 / focal, lighting)
+        return self._image(pose, camera_height, rays, False, supersampling, 1.0 / focal,
+                           lighting)
