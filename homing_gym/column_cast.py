@@ -345,11 +345,15 @@ def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
     p = np.empty(13 * CHUNK)
     triangle, column = np.empty(CHUNK, np.int64), np.empty(CHUNK, np.int64)
     cut = np.empty(14 * CHUNK)
+    # the triangles with columns, listed without a branch (a skip would be mispredicted)
+    seen = np.empty(N, np.int64)
+    m = 0
+    for t in range(N):
+        seen[m] = t
+        m += ranges[1, t] > 0
     n = 0
     ox, oy, oz = origin[0], origin[1], origin[2]
-    for t in range(N):
-        if ranges[1, t] == 0:
-            continue
+    for t in seen[:m]:
         x0, y0, z0 = corners[0, t] - ox, corners[1, t] - oy, corners[2, t] - oz
         x1, y1, z1 = corners[3, t] - ox, corners[4, t] - oy, corners[5, t] - oz
         x2, y2, z2 = corners[6, t] - ox, corners[7, t] - oy, corners[8, t] - oz
