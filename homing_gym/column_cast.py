@@ -216,12 +216,14 @@ _OK, _A0, _H0, _A1, _H1, _W00, _W01, _W02, _W10, _W11, _W12, _TOP, _LOW, _GUESS 
 
 
 @njit(cache=True, error_model="numpy")
-def _cut_columns(n: int, p: np.ndarray, H: int, even_rows: bool, out: np.ndarray) -> None:
+def _cut_columns(n: int, p: np.ndarray, H: int, even_rows: bool, top_angle: float,
+                 rows_per_radian: float, out: np.ndarray) -> None:
     """For the first ``n`` pairs ``p[:, k]`` (:func:`cast_columns`): the triangle cut
     by the plane of the column (:func:`_column_segment`), the tangents of the
     elevations of the segment's ends (``_TOP``, ``_LOW``), and a guess of the first row
-    at or below the upper one, as if rows were evenly spaced in elevation. With
-    ``even_rows`` (they are) a segment that falls between two rows is dropped (``_OK``
+    at or below the upper one, as if rows were evenly spaced in elevation (with
+    ``even_rows`` they are, from ``top_angle`` at ``rows_per_radian`` in every column;
+    else each pair holds its column's). With ``even_rows`` a segment that falls between two rows is dropped (``_OK``
     0): a quarter to a third of them in a world of small triangles. Branch-free, and
     with the rows of ``p`` and ``out`` at constant distances in flat arrays (so that
     the compiler sees they cannot overlap): vectorised."""
@@ -234,8 +236,10 @@ def _cut_columns(n: int, p: np.ndarray, H: int, even_rows: bool, out: np.ndarray
         top = max(ta, tb)
         low = min(ta, tb)
         # fractional rows of the ends: the rows covered are the whole numbers between
-        upper = (p[_TOP_ANGLE * C + k] - _approx_atan2(top, 1.0)) * p[_ROWS_PER_RADIAN * C + k]
-        lower = (p[_TOP_ANGLE * C + k] - _approx_atan2(low, 1.0)) * p[_ROWS_PER_RADIAN * C + k]
+        first = top_angle if even_rows else p[_TOP_ANGLE * C + k]
+        per = rows_per_radian if even_rows else p[_ROWS_PER_RADIAN * C + k]
+        upper = (first - _approx_atan2(top, 1.0)) * per
+        lower = (first - _approx_atan2(low, 1.0)) * per
         between = even_rows & (math.ceil(upper - _ROW_SLACK) > math.floor(lower + _ROW_SLACK))
         out[_OK * C + k] = (1.0 if ok else 0.0) * (0.0 if between else 1.0)
         out[_A0 * C + k], out[_H0 * C + k], out[_A1 * C + k], out[_H1 * C + k] = a0, h0, a1, h1
@@ -364,16 +368,17 @@ def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
                 p[3 * CHUNK + n], p[4 * CHUNK + n], p[5 * CHUNK + n] = x1, y1, z1
                 p[6 * CHUNK + n], p[7 * CHUNK + n], p[8 * CHUNK + n] = x2, y2, z2
                 p[_COS * CHUNK + n], p[_SIN * CHUNK + n] = cos_b[j], sin_b[j]
-                p[_TOP_ANGLE * CHUNK + n] = top_angle[j]
-                p[_ROWS_PER_RADIAN * CHUNK + n] = rows_per_radian[j]
+                if not even_rows:
+                    p[_TOP_ANGLE * CHUNK + n] = top_angle[j]
+                    p[_ROWS_PER_RADIAN * CHUNK + n] = rows_per_radian[j]
                 triangle[n], column[n] = t, j
                 n += 1
                 if n == CHUNK:
-                    _cut_columns(n, p, H, even_rows, cut)
+                    _cut_columns(n, p, H, even_rows, top_angle[0], rows_per_radian[0], cut)
                     _fill_rows(n, triangle, column, cut, tan_elev, even_rows, weighted, hit,
                                weights, depth)
                     n = 0
-    _cut_columns(n, p, H, even_rows, cut)
+    _cut_columns(n, p, H, even_rows, top_angle[0], rows_per_radian[0], cut)
     _fill_rows(n, triangle, column, cut, tan_elev, even_rows, weighted, hit, weights, depth)
 
 
