@@ -153,6 +153,27 @@ def _approx_atan2(y: float, x: float) -> float:
     return -r if y < 0.0 else r
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _bearing_span(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray, t: int,
+                  ox: float, oy: float, oz: float, yaw: float):
+    """``(lo, hi, kind)`` of triangle ``t`` seen from ``(ox, oy, oz)`` (see
+    :func:`triangle_spans`); no branch."""
+    x0, y0 = corners[0, t] - ox, corners[1, t] - oy
+    x1, y1 = corners[3, t] - ox, corners[4, t] - oy
+    x2, y2 = corners[6, t] - ox, corners[7, t] - oy
+    facing = (normals[0, t] * x0 + normals[1, t] * y0 + normals[2, t] * (corners[2, t] - oz))
+    away = closed[t] & (facing >= 0.0)
+    c0, c1, c2 = x0 * y1 - y0 * x1, x1 * y2 - y1 * x2, x2 * y0 - y2 * x0
+    edge_on = (c0 == 0.0) & (c1 == 0.0) & (c2 == 0.0)
+    around = (((c0 >= 0.0) & (c1 >= 0.0) & (c2 >= 0.0))
+              | ((c0 <= 0.0) & (c1 <= 0.0) & (c2 <= 0.0)))
+    d1 = _approx_atan2(x0 * y1 - y0 * x1, x0 * x1 + y0 * y1)
+    d2 = _approx_atan2(x0 * y2 - y0 * x2, x0 * x2 + y0 * y2)
+    a0 = _approx_atan2(y0, x0) - yaw
+    return (a0 + min(min(d1, d2), 0.0) - _ATAN_SLACK, a0 + max(max(d1, d2), 0.0) + _ATAN_SLACK,
+            (SPAN + around) * (1 - (away | edge_on)))
+
+
 @njit(cache=True, error_model="numpy")
 def triangle_spans(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
                    origin: np.ndarray, yaw: float, lo: np.ndarray, hi: np.ndarray,
@@ -168,24 +189,9 @@ def triangle_spans(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
     :data:`_ATAN_SLACK` beyond the error of the approximate arctangents, so that no
     column the triangle reaches is missed: the caster tests each column exactly.
     Branch-free per triangle, so that the loop is vectorised."""
-    ox, oy, oz = origin[0], origin[1], origin[2]
     for t in range(corners.shape[1]):
-        x0, y0 = corners[0, t] - ox, corners[1, t] - oy
-        x1, y1 = corners[3, t] - ox, corners[4, t] - oy
-        x2, y2 = corners[6, t] - ox, corners[7, t] - oy
-        facing = (normals[0, t] * x0 + normals[1, t] * y0
-                  + normals[2, t] * (corners[2, t] - oz))
-        away = closed[t] & (facing >= 0.0)
-        c0, c1, c2 = x0 * y1 - y0 * x1, x1 * y2 - y1 * x2, x2 * y0 - y2 * x0
-        edge_on = (c0 == 0.0) & (c1 == 0.0) & (c2 == 0.0)
-        around = (((c0 >= 0.0) & (c1 >= 0.0) & (c2 >= 0.0))
-                  | ((c0 <= 0.0) & (c1 <= 0.0) & (c2 <= 0.0)))
-        d1 = _approx_atan2(x0 * y1 - y0 * x1, x0 * x1 + y0 * y1)
-        d2 = _approx_atan2(x0 * y2 - y0 * x2, x0 * x2 + y0 * y2)
-        a0 = _approx_atan2(y0, x0) - yaw
-        lo[t] = a0 + min(min(d1, d2), 0.0) - _ATAN_SLACK
-        hi[t] = a0 + max(max(d1, d2), 0.0) + _ATAN_SLACK
-        kind[t] = (SPAN + around) * (1 - (away | edge_on))
+        lo[t], hi[t], kind[t] = _bearing_span(corners, normals, closed, t, origin[0],
+                                              origin[1], origin[2], yaw)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -339,12 +345,13 @@ def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
         top_angle[j] = _approx_atan2(tan_elev[0, j], 1.0)
         span = top_angle[j] - _approx_atan2(tan_elev[H - 1, j], 1.0)
         rows_per_radian[j] = (H - 1) / span if span > 0.0 else 0.0
-    lo, hi, kind = np.empty(N), np.empty(N), np.empty(N, np.int8)
-    triangle_spans(corners, normals, closed, origin, yaw, lo, hi, kind)
-    ranges = np.zeros((4, N), np.int64)          # (first, count) of up to two column runs
+    ranges = np.empty((4, N), np.int32)          # (first, count) of up to two column runs
     if circle:
-        _circle_columns(lo, hi, kind, beta[0], step, W, ranges)
+        _circle_columns(corners, normals, closed, origin, yaw, beta[0], step, W, ranges)
     else:
+        lo, hi, kind = np.empty(N), np.empty(N), np.empty(N, np.int8)
+        triangle_spans(corners, normals, closed, origin, yaw, lo, hi, kind)
+        ranges[:] = 0
         _searched_columns(lo, hi, kind, beta, per_radian, ranges)
     p = np.empty(13 * CHUNK)
     triangle, column = np.empty(CHUNK, np.int64), np.empty(CHUNK, np.int64)
@@ -383,18 +390,24 @@ def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
 
 
 @njit(cache=True, error_model="numpy")
-def _circle_columns(lo: np.ndarray, hi: np.ndarray, kind: np.ndarray, first: float,
-                    step: float, W: int, ranges: np.ndarray) -> None:
-    """``ranges[0:2, t]``: the first column (unwrapped: may lie outside ``[0, W)``) and
-    the number of columns of each triangle's span, for ``W`` columns once round the
-    circle at bearings ``first - j * step``; a little wider than the span (each column
-    is tested exactly). Branch-free: vectorised."""
-    for t in range(lo.shape[0]):
-        j0 = int(math.ceil((first - hi[t]) / step - _INDEX_SLACK))
-        j1 = int(math.floor((first - lo[t]) / step + _INDEX_SLACK)) + 1
-        everywhere = kind[t] == EVERYWHERE
+def _circle_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
+                    origin: np.ndarray, yaw: float, first: float, step: float, W: int,
+                    ranges: np.ndarray) -> None:
+    """``ranges[:, t]``: the first column (unwrapped: may lie outside ``[0, W)``) and
+    the number of columns of each triangle's span (:func:`triangle_spans`; 0 for those
+    skipped), then ``(0, 0)``, for ``W`` columns once round the circle at bearings
+    ``first - j * step``; a little wider than the span (each column is tested exactly).
+    Branch-free: vectorised."""
+    for t in range(corners.shape[1]):
+        lo, hi, kind = _bearing_span(corners, normals, closed, t, origin[0], origin[1],
+                                     origin[2], yaw)
+        j0 = int(math.ceil((first - hi) / step - _INDEX_SLACK))
+        j1 = int(math.floor((first - lo) / step + _INDEX_SLACK)) + 1
+        everywhere = kind == EVERYWHERE
         ranges[0, t] = 0 if everywhere else j0
-        ranges[1, t] = W if everywhere else (0 if kind[t] == SKIP else max(j1 - j0, 0))
+        ranges[1, t] = W if everywhere else (0 if kind == SKIP else max(j1 - j0, 0))
+        ranges[2, t] = 0
+        ranges[3, t] = 0
 
 
 @njit(cache=True, error_model="numpy")
