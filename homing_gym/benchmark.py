@@ -152,31 +152,49 @@ def step_rate(env, n: int, batch: int = 1) -> float:
     return n * batch / (time.perf_counter() - start)
 
 
-def run_config(name: str, env_kwargs: dict, steps: int, workers: int, rounds: int = 10,
-               env_id: str = "homing_gym/LocalHoming-v0") -> BenchmarkResult:
-    """Measure one configuration. Render-only and env blocks alternate over ``rounds``
-    rounds and the medians are reported, so that load from other processes hits both
-    alike; the vector env is measured after them."""
-    env = gym.make(env_id, **env_kwargs)
-    env.action_space.seed(0)
-    env.reset(seed=0)
-    rng = np.random.default_rng(0)
-    render_rate(env, 20, rng)
-    block = max(steps // rounds, 5)
-    renders, singles = [], []
-    for _ in tqdm(range(rounds), desc=f"{name}: render and env"):
-        renders.append(render_rate(env, block, rng))
-        singles.append(step_rate(env, block))
-    env.close()
+def vector_rate(env_kwargs: dict, block: int, workers: int, rounds: int,
+                env_id: str = "homing_gym/LocalHoming-v0") -> float:
+    """Median env steps per second of an ``AsyncVectorEnv`` of ``workers`` processes."""
     vec = gym.make_vec(env_id, num_envs=workers, vectorization_mode="async",
                        vector_kwargs={"context": "spawn"}, **env_kwargs)
     vec.action_space.seed(0)
     vec.reset(seed=0)
-    vector = np.median([step_rate(vec, max(block // workers, 5), batch=workers)
-                        for _ in tqdm(range(rounds), desc=f"{name}: vector x{workers}")])
+    rate = np.median([step_rate(vec, max(block // workers, 5), batch=workers)
+                      for _ in range(rounds)])
     vec.close()
-    return BenchmarkResult(name, env_kwargs, float(np.median(renders)),
-                           float(np.median(singles)), float(vector), workers)
+    return float(rate)
+
+
+def run_configs(configs: dict[str, dict], steps: int, workers: int, rounds: int = 10,
+                env_id: str = "homing_gym/LocalHoming-v0") -> list[BenchmarkResult]:
+    """Measure every configuration. Each round runs a render-only block and an env block
+    of every configuration in turn, and the medians over ``rounds`` rounds are reported,
+    so that load from other processes, and its drift over the run, hits all of them
+    alike (the ratios between configurations are what the tables compare); the vector
+    envs are measured after them, one configuration at a time."""
+    envs, rngs = {}, {}
+    for name, kwargs in configs.items():
+        env = gym.make(env_id, **kwargs)
+        env.action_space.seed(0)
+        env.reset(seed=0)
+        rngs[name] = np.random.default_rng(0)
+        render_rate(env, 20, rngs[name])
+        envs[name] = env
+    block = max(steps // rounds, 5)
+    renders: dict[str, list[float]] = {name: [] for name in configs}
+    singles: dict[str, list[float]] = {name: [] for name in configs}
+    try:
+        for _ in tqdm(range(rounds), desc="render and env, every configuration in turn"):
+            for name, env in envs.items():
+                renders[name].append(render_rate(env, block, rngs[name]))
+                singles[name].append(step_rate(env, block))
+    finally:
+        for env in envs.values():
+            env.close()
+    return [BenchmarkResult(name, kwargs, float(np.median(renders[name])),
+                            float(np.median(singles[name])),
+                            vector_rate(kwargs, block, workers, rounds, env_id), workers)
+            for name, kwargs in tqdm(configs.items(), desc=f"vector envs x{workers}")]
 
 
 def reset_ms(scene: str, new_world: bool, n: int, blocks: int = 5) -> float:
@@ -206,19 +224,25 @@ def reset_table(n: int) -> str:
 
 def format_table(results: list[BenchmarkResult]) -> str:
     """A Markdown table of the results; ``env vs tiny``: env steps/s over those of
-    ``renderer="tiny"`` at the same shape in the same run."""
-    def key(r: BenchmarkResult) -> tuple:
-        return (tuple(r.env_kwargs["panorama_shape"]), str(r.env_kwargs.get("scene")),
-                r.env_kwargs.get("physics_substeps"))
+    ``renderer="tiny"`` at the same shape in the same world; ``env vs arena``: over
+    those of the same renderer and shape in the arena (both measured in the same run)."""
+    def key(r: BenchmarkResult, scene: bool = True, renderer: bool = False) -> tuple:
+        return (tuple(r.env_kwargs["panorama_shape"]), r.env_kwargs.get("physics_substeps"),
+                str(r.env_kwargs.get("scene")) if scene else None,
+                r.env_kwargs.get("renderer") if renderer else None)
 
     tiny = {key(r): r.env_steps_per_s for r in results if r.env_kwargs.get("renderer") == "tiny"}
-    lines = ["| config | render (pano/s) | env (steps/s) | env vs tiny | env / render time | "
-             "AsyncVectorEnv (steps/s) |", "|---|---|---|---|---|---|"]
+    arena = {key(r, False, True): r.env_steps_per_s for r in results
+             if "scene" not in r.env_kwargs}
+    lines = ["| config | render (pano/s) | env (steps/s) | env vs tiny | env vs arena | "
+             "env / render time | AsyncVectorEnv (steps/s) |", "|---|---|---|---|---|---|---|"]
     for r in results:
         ref = tiny.get(key(r))
         versus = f"{r.env_steps_per_s / ref:.2f}x" if ref else "-"
+        ref = arena.get(key(r, False, True)) if "scene" in r.env_kwargs else None
+        world = f"{r.env_steps_per_s / ref:.2f}x" if ref else "-"
         lines.append(f"| {r.config} | {r.render_per_s:.1f} | {r.env_steps_per_s:.1f} | "
-                     f"{versus} | {r.ratio:.3f} | {r.vector_steps_per_s:.1f} "
+                     f"{versus} | {world} | {r.ratio:.3f} | {r.vector_steps_per_s:.1f} "
                      f"({r.workers} workers) |")
     return "\n".join(lines)
 
@@ -253,8 +277,8 @@ def main(argv: list[str] | None = None) -> int:
             open(args.json, "w").close()
         except OSError as err:
             parser.error(f"--json {args.json!r}: cannot write it ({err.strerror})")
-    results = [run_config(name, kwargs, args.steps, args.workers)
-               for name, kwargs in configs(args.renderers, args.shapes, args.worlds).items()]
+    results = run_configs(configs(args.renderers, args.shapes, args.worlds), args.steps,
+                          args.workers)
     print(format_table(results))
     if args.resets:
         print(reset_table(args.resets))
