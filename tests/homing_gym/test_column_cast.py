@@ -1,0 +1,86 @@
+"""The column caster's shortcuts: each gives exactly the hits of the plain search."""
+
+import math
+
+import numpy as np
+import pytest
+
+from homing_gym.benchmark import mesh_world
+from homing_gym.column_cast import _ATAN_SLACK, _approx_atan2, cast_columns
+from homing_gym.raycast import panorama_rays
+from homing_gym.worldmesh import world_mesh
+
+
+@pytest.fixture(scope="module")
+def rocks():
+    """The benchmark's mesh world (30 lumpy rocks, 9,650 small triangles), as the caster
+    takes it, and camera poses in it."""
+    mesh = world_mesh(mesh_world())
+    rng = np.random.default_rng(0)
+    poses = [(x, y, rng.uniform(-math.pi, math.pi), rng.choice([0.05, 0.3, 1.2]))
+             for x, y in rng.uniform(-4.5, 4.5, (8, 2))]
+    return mesh, poses
+
+
+def _cast(mesh, pose, beta, tan, even_rows=True, weighted=None):
+    x, y, yaw, height = pose
+    H, W = tan.shape
+    hit, weights = np.empty((H, W), np.int64), np.full((H, W, 3), np.nan)
+    depth = np.empty((W, H))
+    if weighted is None:
+        weighted = np.ones(len(mesh.triangles), np.bool_)
+    cast_columns(np.ascontiguousarray(mesh.triangles.reshape(-1, 9).T),
+                 np.ascontiguousarray(mesh.normals.T), mesh.closed, np.array([x, y, height]),
+                 yaw, beta, tan, even_rows, weighted, hit, weights, depth)
+    return hit, weights, depth.T
+
+
+def test_the_approximate_arctangent_is_within_its_stated_error():
+    rng = np.random.default_rng(0)
+    ys, xs = rng.normal(size=(2, 20000)) * rng.choice([1e-6, 1.0, 1e6], (2, 20000))
+    ys[:4], xs[:4] = [0.0, 1.0, -1.0, 0.0], [1.0, 0.0, 0.0, -1.0]   # on the axes
+    error = max(abs(_approx_atan2(y, x) - math.atan2(y, x)) for y, x in zip(ys, xs)
+                if not (y == 0.0 and x < 0.0))                     # +-pi: the same bearing
+    assert error < 2.9e-7 < _ATAN_SLACK / 2
+
+
+def test_dropping_segments_between_rows_changes_no_pixel(rocks):
+    """Where the rows are even in elevation the caster drops segments that fall between
+    two rows before it searches their rows; the hits are those of the search alone."""
+    mesh, poses = rocks
+    beta, tan = panorama_rays((48, 256), math.radians(60), 2)
+    for pose in poses:
+        dropped, _, near = _cast(mesh, pose, beta, tan, even_rows=True)
+        searched, _, far = _cast(mesh, pose, beta, tan, even_rows=False)
+        assert np.array_equal(dropped, searched) and np.array_equal(near, far)
+        assert (dropped >= 0).mean() > 0.4                  # the rocks, walls and floor
+
+
+def test_columns_found_by_arithmetic_are_those_found_by_search(rocks):
+    """A panorama's columns go once round the circle at even steps, so the caster finds
+    a triangle's columns by arithmetic; without the last column they do not, and it
+    searches: every other column comes out the same."""
+    mesh, poses = rocks
+    beta, tan = panorama_rays((48, 256), math.radians(60), 1)
+    for pose in poses:
+        circle, _, _ = _cast(mesh, pose, beta, tan)
+        searched, _, _ = _cast(mesh, pose, beta[:-1].copy(), np.asfortranarray(tan[:, :-1]))
+        assert np.array_equal(circle[:, :-1], searched)
+
+
+def test_weights_are_written_only_where_the_shader_reads_them(rocks):
+    mesh, poses = rocks
+    beta, tan = panorama_rays((48, 256), math.radians(60), 1)
+    rng = np.random.default_rng(1)
+    weighted = rng.random(len(mesh.triangles)) < 0.5
+    for pose in poses[:3]:
+        hit, weights, _ = _cast(mesh, pose, beta, tan, weighted=weighted)
+        every, all_weights, _ = _cast(mesh, pose, beta, tan)
+        assert np.array_equal(hit, every)
+        seen = hit >= 0
+        needed = seen & weighted[np.maximum(hit, 0)]
+        assert needed.any() and (seen & ~needed).any()
+        assert np.array_equal(weights[needed], all_weights[needed])
+        np.testing.assert_allclose(all_weights[seen].sum(1), 1.0, atol=1e-9)
+        none = np.zeros(len(mesh.triangles), np.bool_)
+        assert np.isnan(_cast(mesh, pose, beta, tan, weighted=none)[1]).all()
