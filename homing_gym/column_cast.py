@@ -114,20 +114,22 @@ def _column_segment(x0: float, y0: float, z0: float, x1: float, y1: float, z1: f
     w11 = 1 - u12 if alone1 else 0.0
     w12 = u12 if alone1 else 1 - u20
     ok = ~((b0 == b1) & (b1 == b2)) & ((a0 >= NEAR) | (a1 >= NEAR))
-    # an end behind the camera moves to just in front of it
-    f = (NEAR - a0) / (a1 - a0)
-    behind = a0 < NEAR
-    a0, h0 = (a0 + f * (a1 - a0) if behind else a0), (h0 + f * (h1 - h0) if behind else h0)
-    w00 = w00 + f * (w10 - w00) if behind else w00
-    w01 = w01 + f * (w11 - w01) if behind else w01
-    w02 = w02 + f * (w12 - w02) if behind else w02
-    f = (NEAR - a1) / (a0 - a1)
-    behind = a1 < NEAR
-    a1, h1 = (a1 + f * (a0 - a1) if behind else a1), (h1 + f * (h0 - h1) if behind else h1)
-    w10 = w10 + f * (w00 - w10) if behind else w10
-    w11 = w11 + f * (w01 - w11) if behind else w11
-    w12 = w12 + f * (w02 - w12) if behind else w12
-    return ok, a0, h0, a1, h1, (w00, w01, w02), (w10, w11, w12)
+    a0, h0, w0 = _in_front(a0, h0, (w00, w01, w02), a1, h1, (w10, w11, w12))
+    a1, h1, w1 = _in_front(a1, h1, (w10, w11, w12), a0, h0, w0)
+    return ok, a0, h0, a1, h1, w0, w1
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _in_front(a: float, h: float, w: tuple, a_other: float, h_other: float, w_other: tuple):
+    """A segment's end ``(a, h, w)`` (distance along, height, weights), if it lies behind
+    the camera (``a < NEAR``), moved along the segment towards the other end to just in
+    front of it; no branch."""
+    f = (NEAR - a) / (a_other - a)
+    behind = a < NEAR
+    return ((a + f * (a_other - a) if behind else a), (h + f * (h_other - h) if behind else h),
+            (w[0] + f * (w_other[0] - w[0]) if behind else w[0],
+             w[1] + f * (w_other[1] - w[1]) if behind else w[1],
+             w[2] + f * (w_other[2] - w[2]) if behind else w[2]))
 
 
 #: ``atan(a) = a * P(a**2)`` on ``[0, 1]``: a least-squares Chebyshev fit of degree 7
