@@ -193,7 +193,9 @@ def run_matrix(protocols: Sequence[Protocol], out: Path, episodes: int | None = 
                progress: bool = True, resume: bool = False, backend: str = "local",
                address: str | None = None) -> list[Cell]:
     """Every applicable method (or those of ``methods`` that apply) on every protocol;
-    cells under ``out/<protocol>/<method>/``, the matrix files in ``out``."""
+    cells under ``out/<protocol>/<method>/``, the matrix files in ``out``. With
+    ``resume`` the cells of an earlier ``out/matrix.json`` that were not run again (other
+    methods or protocols) stay in the matrix."""
     cells = []
     for protocol in protocols:
         for method in cell_methods(protocol):
@@ -201,6 +203,8 @@ def run_matrix(protocols: Sequence[Protocol], out: Path, episodes: int | None = 
                 continue
             cells.append(run_cell(protocol, method, out / protocol.name / method, episodes,
                                   workers, progress, resume, backend, address))
+    if resume and (out / "matrix.json").exists():
+        cells = merged_cells(load_cells(out / "matrix.json"), cells)
     write_matrix(cells, out)
     return cells
 

@@ -105,8 +105,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", default="results", help="output folder (default: results)")
     parser.add_argument("--resume", action="store_true",
                         help="with --protocols: keep the episodes already streamed into --out "
-                        "(an interrupted matrix, or one to which protocols were added) and "
-                        "run only the others")
+                        "(an interrupted matrix, or one to which protocols or methods were "
+                        "added) and run only the others; the cells of --out's matrix.json "
+                        "that this run does not cover stay in it")
     add_backend_arguments(parser)
     args = parser.parse_args(argv)
     if (args.episodes is not None and args.episodes < 1) or args.workers < 1:

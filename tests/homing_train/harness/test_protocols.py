@@ -221,6 +221,27 @@ def test_merged_cells_replace_the_same_cell_and_keep_the_order():
         ("bekris-lab", "bearing", 0.5)]
 
 
+def test_a_resumed_matrix_keeps_the_cells_it_did_not_run_again(tmp_path, monkeypatch):
+    from homing_train.harness import matrix
+
+    def fake_cell(protocol, method, out, episodes, *args):
+        summary = {"episodes": episodes, "success_rate": 0.5, "success_ci": [0.2, 0.8],
+                   "reached_rate": 0.5, "reached_ci": [0.2, 0.8], "spl": 0.4,
+                   "final_distance_mean": 0.3}
+        return Cell(protocol.name, protocol.version, method, f"run {episodes}", summary, {})
+
+    monkeypatch.setattr(matrix, "run_cell", fake_cell)
+    yukim = protocol("yukim")
+    first, second = cell_methods(yukim)[:2]
+    matrix.run_matrix([yukim], tmp_path, 10, methods=[first, second], progress=False)
+    matrix.run_matrix([yukim], tmp_path, 20, methods=[second], progress=False, resume=True)
+    kept = {(c.method, c.summary["episodes"]) for c in matrix.load_cells(tmp_path / "matrix.json")}
+    assert kept == {(first, 10), (second, 20)}
+    # without --resume a run writes the matrix of what it ran
+    matrix.run_matrix([yukim], tmp_path, 30, methods=[second], progress=False)
+    assert [c.method for c in matrix.load_cells(tmp_path / "matrix.json")] == [second]
+
+
 def test_hong_starts_are_one_foot_from_home_with_the_homes_heading():
     from homing_train.harness.protocols import FOOT, common_heading_starts
 
