@@ -314,7 +314,8 @@ def _fill_rows(n: int, triangle: np.ndarray, column: np.ndarray, cut: np.ndarray
 @njit(cache=True, error_model="numpy")
 def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
                  origin: np.ndarray, yaw: float, beta: np.ndarray, tan_elev: np.ndarray,
-                 even_rows: bool, weighted: np.ndarray, hit: np.ndarray,
+                 circle: bool, even_rows: bool, top_angle: np.ndarray,
+                 rows_per_radian: np.ndarray, weighted: np.ndarray, hit: np.ndarray,
                  weights: np.ndarray, depth: np.ndarray) -> None:
     """Nearest triangle per pixel.
 
@@ -325,19 +326,21 @@ def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
     outside the solid); ``origin (3,)`` the camera; ``yaw`` its heading (radians);
     ``beta (W,)`` column bearings relative to the heading, strictly descending within
     ``(-pi, pi]``; ``tan_elev (H, W)`` tangent of each pixel's ray elevation,
-    descending down each column; ``even_rows``: every column has the same rows, evenly
-    spaced in elevation (a panorama's), which lets segments that fall between two rows
-    be dropped early (else the rows are only searched). Writes ``hit (H, W)`` the
+    descending down each column; ``circle``, ``even_rows``, ``top_angle``,
+    ``rows_per_radian``: their layout (:class:`homing_gym.raycast.Rays`; with columns
+    once round the circle at even steps a span's columns are found by arithmetic, else
+    by searching ``beta``; with rows even in elevation and the same in every column,
+    segments that fall between two rows are dropped early). Writes ``hit (H, W)`` the
     triangle index (``-1``: nothing) and ``weights (H, W, 3)`` the barycentric weights
     of the hit where the triangle is ``weighted`` (``(N,)`` bool: the shader needs them,
-    for a texture or a shadow; elsewhere left as they were); ``depth (W, H)`` is scratch (the nearest hit's horizontal distance so
-    far, column by column like the loops below), overwritten.
+    for a texture or a shadow; elsewhere left as they were); ``depth (W, H)`` is scratch
+    (the nearest hit's horizontal distance so far, column by column like the loops
+    below), overwritten.
 
     Three passes: the triangles' bearing spans, all at once (:func:`triangle_spans`);
     the pairs of a triangle and a column in its span, cut :data:`CHUNK` at a time
     (:func:`_cut_columns`); then their rows (:func:`_fill_rows`), in the order of the
-    triangles. Where the columns go once round the circle at even steps (a panorama)
-    a span's columns are found by arithmetic, else by searching ``beta``.
+    triangles.
     """
     H, W = tan_elev.shape
     N = corners.shape[1]
@@ -348,14 +351,6 @@ def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
     # columns per radian if evenly spaced: where the searches for a bearing start
     per_radian = (W - 1) / (beta[0] - beta[W - 1]) if W > 1 else 0.0
     step = 2 * math.pi / W
-    circle = W > 1
-    for j in range(1, W):
-        circle = circle and abs(beta[j - 1] - beta[j] - step) < 1e-9
-    top_angle, rows_per_radian = np.empty(W), np.empty(W)
-    for j in range(W):
-        top_angle[j] = _approx_atan2(tan_elev[0, j], 1.0)
-        span = top_angle[j] - _approx_atan2(tan_elev[H - 1, j], 1.0)
-        rows_per_radian[j] = (H - 1) / span if span > 0.0 else 0.0
     ranges = np.empty((4, N), np.int32)          # (first, count) of up to two column runs
     if circle:
         _circle_columns(corners, normals, closed, origin, yaw, beta[0], step, W, ranges)

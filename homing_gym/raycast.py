@@ -34,6 +34,7 @@ check pixel for pixel that both hit the same triangles.
 from __future__ import annotations
 
 from functools import lru_cache
+from typing import NamedTuple
 
 import cv2
 import numpy as np
@@ -56,24 +57,53 @@ def _centres(n: int, k: int) -> np.ndarray:
     return (np.arange(n * k) + 0.5) / k
 
 
+class Rays(NamedTuple):
+    """A camera's rays, and how they are laid out (derived once per camera, so that the
+    caster need not check it for every image): ``beta (W,)`` column bearings (radians,
+    counter-clockwise from the heading, descending); ``tan_elev (H, W)`` the tangent of
+    each ray's elevation (descending down each column); ``circle``: the columns go once
+    round the circle at even steps (a panorama); ``even_rows``: every column has the same
+    rows, evenly spaced in elevation (a panorama); ``top_angle (W,)`` the elevation of
+    each column's first row and ``rows_per_radian (W,)`` its rows per radian of elevation
+    as if they were evenly spaced (where the caster's row searches start)."""
+
+    beta: np.ndarray
+    tan_elev: np.ndarray
+    circle: bool
+    even_rows: bool
+    top_angle: np.ndarray
+    rows_per_radian: np.ndarray
+
+
+def camera_rays(beta: np.ndarray, tan_elev: np.ndarray) -> Rays:
+    """:class:`Rays` of the columns ``beta`` and their rows' ``tan_elev``."""
+    H, W = tan_elev.shape
+    circle = W > 1 and bool(np.all(np.abs(-np.diff(beta) - 2 * np.pi / W) < 1e-9))
+    elevation = np.arctan(tan_elev)
+    top, span = elevation[0], elevation[0] - elevation[-1]
+    per = np.divide(H - 1, span, out=np.zeros(W), where=span > 0)
+    even = (per[0] * (top[0] - elevation[:, 0]) - np.arange(H)) if H > 1 else np.zeros(1)
+    even_rows = bool(np.all(tan_elev == tan_elev[:, :1]) and np.all(np.abs(even) < 1e-6))
+    return Rays(beta, np.asfortranarray(tan_elev), circle, even_rows, top, per)
+
+
 @lru_cache(maxsize=32)
-def panorama_rays(shape: tuple[int, int], vfov: float, k: int = 1):
-    """``(beta (k*W,), tan_elev (k*H, k*W))`` of the panorama's pixel centres (and
-    ``k x k`` samples per pixel): column bearings (radians, counter-clockwise from the
-    heading, descending) and the tangent of each ray's elevation."""
+def panorama_rays(shape: tuple[int, int], vfov: float, k: int = 1) -> Rays:
+    """The rays of the panorama's pixel centres (and ``k x k`` samples per pixel):
+    ``k*W`` columns, ``k*H`` rows."""
     H, W = shape
     beta = column_bearing(_centres(W, k), W)
     tan = np.tan(row_elevation(_centres(H, k), H, vfov))
-    return beta, np.asfortranarray(np.broadcast_to(tan[:, None], (k * H, k * W)))
+    return camera_rays(beta, np.broadcast_to(tan[:, None], (k * H, k * W)))
 
 
 @lru_cache(maxsize=32)
-def perspective_rays(width: int, height: int, focal: float, k: int = 1):
-    """``(beta, tan_elev)`` of an upright pinhole camera along the heading (pixel centres
+def perspective_rays(width: int, height: int, focal: float, k: int = 1) -> Rays:
+    """The rays of an upright pinhole camera along the heading (pixel centres
     ``(i + 0.5, j + 0.5)``, focal length in pixels)."""
     left = (width / 2 - _centres(width, k)) / focal
     up = (height / 2 - _centres(height, k)) / focal
-    return np.arctan(left), np.asfortranarray(up[:, None] / np.sqrt(1 + left[None, :] ** 2))
+    return camera_rays(np.arctan(left), up[:, None] / np.sqrt(1 + left[None, :] ** 2))
 
 
 def mip_levels(texture: np.ndarray) -> list[np.ndarray]:
@@ -178,16 +208,15 @@ class RayCaster:
                                      np.empty((W, H)))
         return self._scratch[(H, W)]
 
-    def _image(self, pose, camera_height: float, rays, even_rows: bool, k: int,
-               spacing: float, lighting: Lighting | None) -> np.ndarray:
-        beta, tan_elev = rays
+    def _image(self, pose, camera_height: float, rays: Rays, k: int, spacing: float,
+               lighting: Lighting | None) -> np.ndarray:
         x, y, yaw = (float(v) for v in pose)
-        H, W = tan_elev.shape
+        H, W = rays.tan_elev.shape
         hit, weights, depth = self._buffers(H, W)
         origin = np.array([x, y, camera_height])
         weighted = self._everywhere if self.shadows else self._textured
-        cast_columns(self._corners, self._normals_by_axis, self._closed, origin, yaw, beta,
-                     tan_elev, even_rows, weighted, hit, weights, depth)
+        cast_columns(self._corners, self._normals_by_axis, self._closed, origin, yaw, *rays,
+                     weighted, hit, weights, depth)
         image = np.empty((H // k, W // k, 3), np.uint8)
         light = lighting or DEFAULT_LIGHTING
         shadow = self._shadow_map(light) if self.shadows else _NO_SHADOWS
@@ -207,11 +236,10 @@ class RayCaster:
         rays = panorama_rays((H, W), config.vfov, k)
         # each ray filters the texture over a whole pixel (see :func:`shade`'s caller note)
         spacing = max(2 * np.pi / W, config.vfov / H)
-        return self._image(pose, camera_height, rays, True, k, spacing, lighting)
+        return self._image(pose, camera_height, rays, k, spacing, lighting)
 
     def perspective(self, pose, camera_height: float, width: int, height: int, focal: float,
                     lighting: Lighting | None = None, supersampling: int = 1) -> np.ndarray:
         """A pinhole view (uint8 ``(height, width, 3)``) along the heading at ``pose``."""
         rays = perspective_rays(width, height, float(focal), supersampling)
-        return self._image(pose, camera_height, rays, False, supersampling, 1.0 / focal,
-                           lighting)
+        return self._image(pose, camera_height, rays, supersampling, 1.0 / focal, lighting)

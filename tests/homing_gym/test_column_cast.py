@@ -7,7 +7,7 @@ import pytest
 
 from homing_gym.benchmark import mesh_world
 from homing_gym.column_cast import _ATAN_SLACK, _approx_atan2, cast_columns
-from homing_gym.raycast import panorama_rays
+from homing_gym.raycast import camera_rays, panorama_rays, perspective_rays
 from homing_gym.worldmesh import world_mesh
 
 
@@ -22,16 +22,16 @@ def rocks():
     return mesh, poses
 
 
-def _cast(mesh, pose, beta, tan, even_rows=True, weighted=None):
+def _cast(mesh, pose, rays, weighted=None):
     x, y, yaw, height = pose
-    H, W = tan.shape
+    H, W = rays.tan_elev.shape
     hit, weights = np.empty((H, W), np.int64), np.full((H, W, 3), np.nan)
     depth = np.empty((W, H))
     if weighted is None:
         weighted = np.ones(len(mesh.triangles), np.bool_)
     cast_columns(np.ascontiguousarray(mesh.triangles.reshape(-1, 9).T),
                  np.ascontiguousarray(mesh.normals.T), mesh.closed, np.array([x, y, height]),
-                 yaw, beta, tan, even_rows, weighted, hit, weights, depth)
+                 yaw, *rays, weighted, hit, weights, depth)
     return hit, weights, depth.T
 
 
@@ -44,14 +44,25 @@ def test_the_approximate_arctangent_is_within_its_stated_error():
     assert error < 2.9e-7 < _ATAN_SLACK / 2
 
 
+def test_a_camera_knows_its_ray_layout():
+    pano = panorama_rays((48, 256), math.radians(60), 2)
+    assert pano.circle and pano.even_rows and pano.tan_elev.shape == (96, 512)
+    np.testing.assert_allclose(pano.top_angle, math.radians(30) - math.radians(60) / 192)
+    np.testing.assert_allclose(pano.rows_per_radian, 95 / (math.radians(60) * 95 / 96))
+    view = perspective_rays(160, 120, 140.0)
+    assert not view.circle and not view.even_rows
+    part = camera_rays(pano.beta[:-1], pano.tan_elev[:, :-1])
+    assert not part.circle and part.even_rows
+
+
 def test_dropping_segments_between_rows_changes_no_pixel(rocks):
     """Where the rows are even in elevation the caster drops segments that fall between
     two rows before it searches their rows; the hits are those of the search alone."""
     mesh, poses = rocks
-    beta, tan = panorama_rays((48, 256), math.radians(60), 2)
+    rays = panorama_rays((48, 256), math.radians(60), 2)
     for pose in poses:
-        dropped, _, near = _cast(mesh, pose, beta, tan, even_rows=True)
-        searched, _, far = _cast(mesh, pose, beta, tan, even_rows=False)
+        dropped, _, near = _cast(mesh, pose, rays)
+        searched, _, far = _cast(mesh, pose, rays._replace(even_rows=False))
         assert np.array_equal(dropped, searched) and np.array_equal(near, far)
         assert (dropped >= 0).mean() > 0.4                  # the rocks, walls and floor
 
@@ -61,21 +72,22 @@ def test_columns_found_by_arithmetic_are_those_found_by_search(rocks):
     a triangle's columns by arithmetic; without the last column they do not, and it
     searches: every other column comes out the same."""
     mesh, poses = rocks
-    beta, tan = panorama_rays((48, 256), math.radians(60), 1)
+    rays = panorama_rays((48, 256), math.radians(60), 1)
+    part = camera_rays(rays.beta[:-1].copy(), rays.tan_elev[:, :-1])
     for pose in poses:
-        circle, _, _ = _cast(mesh, pose, beta, tan)
-        searched, _, _ = _cast(mesh, pose, beta[:-1].copy(), np.asfortranarray(tan[:, :-1]))
+        circle, _, _ = _cast(mesh, pose, rays)
+        searched, _, _ = _cast(mesh, pose, part)
         assert np.array_equal(circle[:, :-1], searched)
 
 
 def test_weights_are_written_only_where_the_shader_reads_them(rocks):
     mesh, poses = rocks
-    beta, tan = panorama_rays((48, 256), math.radians(60), 1)
+    rays = panorama_rays((48, 256), math.radians(60), 1)
     rng = np.random.default_rng(1)
     weighted = rng.random(len(mesh.triangles)) < 0.5
     for pose in poses[:3]:
-        hit, weights, _ = _cast(mesh, pose, beta, tan, weighted=weighted)
-        every, all_weights, _ = _cast(mesh, pose, beta, tan)
+        hit, weights, _ = _cast(mesh, pose, rays, weighted=weighted)
+        every, all_weights, _ = _cast(mesh, pose, rays)
         assert np.array_equal(hit, every)
         seen = hit >= 0
         needed = seen & weighted[np.maximum(hit, 0)]
@@ -83,4 +95,4 @@ def test_weights_are_written_only_where_the_shader_reads_them(rocks):
         assert np.array_equal(weights[needed], all_weights[needed])
         np.testing.assert_allclose(all_weights[seen].sum(1), 1.0, atol=1e-9)
         none = np.zeros(len(mesh.triangles), np.bool_)
-        assert np.isnan(_cast(mesh, pose, beta, tan, weighted=none)[1]).all()
+        assert np.isnan(_cast(mesh, pose, rays, weighted=none)[1]).all()

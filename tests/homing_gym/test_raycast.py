@@ -172,13 +172,14 @@ def test_every_pixel_hits_what_embree_hits(scene):
              if clearance(world, (x, y)) > 0.02]
     for x, y, yaw in poses[:3]:
         origin = np.array([x, y, rng.uniform(0.05, 0.5)])
-        for (beta, tan), even_rows in ((panorama_rays((48, 256), math.radians(60)), True),
-                                       (perspective_rays(160, 120, 140.0), False)):
+        for rays in (panorama_rays((48, 256), math.radians(60)),
+                     perspective_rays(160, 120, 140.0)):
+            beta, tan = rays.beta, rays.tan_elev
             H, W = tan.shape
             hit, weights = np.empty((H, W), np.int64), np.empty((H, W, 3))
             cast_columns(tris.reshape(-1, 9).T.copy(), mesh.normals.T.copy(), mesh.closed,
-                         origin, yaw, beta, tan, even_rows, np.ones(len(tris), np.bool_), hit,
-                         weights, np.empty((W, H)))
+                         origin, yaw, *rays, np.ones(len(tris), np.bool_), hit, weights,
+                         np.empty((W, H)))
             cos_e = 1 / np.sqrt(1 + tan ** 2)
             dirs = np.stack([cos_e * np.cos(yaw + beta), cos_e * np.sin(yaw + beta),
                              cos_e * tan], -1).reshape(-1, 3).astype(np.float32)
