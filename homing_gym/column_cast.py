@@ -437,10 +437,10 @@ def _searched_columns(lo: np.ndarray, hi: np.ndarray, kind: np.ndarray, beta: np
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _texel(atlas: np.ndarray, levels: np.ndarray, m: int, s: float, v: float,
-           out: np.ndarray) -> None:
+def _texel(atlas: np.ndarray, levels: np.ndarray, m: int, s: float, v: float):
     """Bilinear sample (wrapped) of mip level ``levels[m] = (offset, height, width)`` at
-    texture coordinates ``(s, v)`` (``v`` bottom to top) into ``out (3,)``."""
+    texture coordinates ``(s, v)`` (``v`` bottom to top): ``(r, g, b)``, returned in
+    registers rather than through memory."""
     off, h, w = levels[m, 0], levels[m, 1], levels[m, 2]
     x = (s - math.floor(s)) * w - 0.5                # in [-0.5, w - 0.5)
     y = (math.ceil(v) - v) * h - 0.5                 # rows run top to bottom
@@ -457,10 +457,17 @@ def _texel(atlas: np.ndarray, levels: np.ndarray, m: int, s: float, v: float,
         yb -= h
     a, b = off + 3 * (ya * w + xa), off + 3 * (ya * w + xb)
     c_, d = off + 3 * (yb * w + xa), off + 3 * (yb * w + xb)
-    for c in range(3):
-        top = (1 - fx) * atlas[a + c] + fx * atlas[b + c]
-        bottom = (1 - fx) * atlas[c_ + c] + fx * atlas[d + c]
-        out[c] = (1 - fy) * top + fy * bottom
+    return (_bilinear(atlas, a, b, c_, d, fx, fy), _bilinear(atlas, a + 1, b + 1, c_ + 1, d + 1, fx, fy),
+            _bilinear(atlas, a + 2, b + 2, c_ + 2, d + 2, fx, fy))
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _bilinear(atlas: np.ndarray, a: int, b: int, c: int, d: int, fx: float, fy: float) -> float:
+    """``atlas[a]``, ``[b]`` (the top row's two texels), ``[c]``, ``[d]`` (the bottom's)
+    blended by the fractions ``fx`` across and ``fy`` down."""
+    top = (1 - fx) * atlas[a] + fx * atlas[b]
+    bottom = (1 - fx) * atlas[c] + fx * atlas[d]
+    return (1 - fy) * top + fy * bottom
 
 
 @njit(cache=True, error_model="numpy")
@@ -530,7 +537,6 @@ def shade(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.nd
     k = hit.shape[0] // rows
     mean = np.float32(1.0 / (k * k))
     shadows = shadow_depth.size > 0
-    near, far = np.empty(3), np.empty(3)
     zero = np.float32(0.0)
     for jo in range(cols):
         for io in range(rows):
@@ -576,15 +582,16 @@ def shade(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.nd
                                              levels[base_level, 2])
                                 col = min(max(int((s % 1.0) * w), 0), w - 1)
                                 row = min(max(int((1.0 - v % 1.0) * h), 0), h - 1)
-                                for c in range(3):
-                                    near[c] = atlas[off + 3 * (row * w + col) + c]
+                                at = off + 3 * (row * w + col)
+                                nr, ng, nb = float(atlas[at]), float(atlas[at + 1]), float(atlas[at + 2])
                             else:
-                                _texel(atlas, levels, base_level + m, s, v, near)
+                                nr, ng, nb = _texel(atlas, levels, base_level + m, s, v)
                             if frac > 0.0 and m < top and texel_density[t] > 0.0:
-                                _texel(atlas, levels, base_level + m + 1, s, v, far)
-                                for c in range(3):
-                                    near[c] = (1 - frac) * near[c] + frac * far[c]
-                            r, g, b = r * near[0], g * near[1], b * near[2]
+                                fr, fg, fb = _texel(atlas, levels, base_level + m + 1, s, v)
+                                nr = (1 - frac) * nr + frac * fr
+                                ng = (1 - frac) * ng + frac * fg
+                                nb = (1 - frac) * nb + frac * fb
+                            r, g, b = r * nr, g * ng, b * nb
                         r, g, b = min(max(r, 0.0), 1.0), min(max(g, 0.0), 1.0), min(max(b, 0.0), 1.0)
                     acc_r += np.float32(r)
                     acc_g += np.float32(g)
