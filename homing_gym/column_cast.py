@@ -181,6 +181,7 @@ def _bearing_span(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray, 
     d1 = _approx_atan2(x0 * y1 - y0 * x1, x0 * x1 + y0 * y1)
     d2 = _approx_atan2(x0 * y2 - y0 * x2, x0 * x2 + y0 * y2)
     a0 = _approx_atan2(y0, x0) - yaw
+    a0 -= 2 * math.pi * math.floor((a0 + math.pi) / (2 * math.pi))   # into [-pi, pi)
     return (a0 + min(min(d1, d2), 0.0) - _ATAN_SLACK, a0 + max(max(d1, d2), 0.0) + _ATAN_SLACK,
             (SPAN + around) * (1 - (away | edge_on)))
 
@@ -196,7 +197,9 @@ def triangle_spans(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
     Writes ``kind[t]``: :data:`SKIP` (a closed solid's face turned away from the camera,
     or one seen edge-on), :data:`EVERYWHERE` (the camera's vertical line passes through
     it) or :data:`SPAN`, with ``[lo[t], hi[t]]`` holding the bearings of its corners
-    relative to the heading (radians, counter-clockwise; ``hi - lo < pi``), widened by
+    relative to the heading (radians, counter-clockwise; ``hi - lo < pi``; both within
+    ``[-2 pi, 2 pi]`` for any heading, the first corner's bearing being wrapped into
+    ``[-pi, pi)``), widened by
     :data:`_ATAN_SLACK` beyond the error of the approximate arctangents, so that no
     column the triangle reaches is missed: the caster tests each column exactly.
     Branch-free per triangle, so that the loop is vectorised."""
@@ -376,7 +379,7 @@ def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
         x2, y2, z2 = corners[6, t] - ox, corners[7, t] - oy, corners[8, t] - oz
         for r in range(0, 4, 2):
             for jj in range(ranges[r, t], ranges[r, t] + ranges[r + 1, t]):
-                j = jj + W if jj < 0 else (jj - W if jj >= W else jj)
+                j = jj - W if jj >= W else jj
                 p[n], p[CHUNK + n], p[2 * CHUNK + n] = x0, y0, z0
                 p[3 * CHUNK + n], p[4 * CHUNK + n], p[5 * CHUNK + n] = x1, y1, z1
                 p[6 * CHUNK + n], p[7 * CHUNK + n], p[8 * CHUNK + n] = x2, y2, z2
@@ -399,19 +402,21 @@ def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
 def _circle_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
                     origin: np.ndarray, yaw: float, first: float, step: float, W: int,
                     ranges: np.ndarray) -> None:
-    """``ranges[:, t]``: the first column (unwrapped: may lie outside ``[0, W)``) and
-    the number of columns of each triangle's span (:func:`triangle_spans`; 0 for those
-    skipped), then ``(0, 0)``, for ``W`` columns once round the circle at bearings
-    ``first - j * step``; a little wider than the span (each column is tested exactly).
-    Branch-free: vectorised."""
+    """``ranges[:, t]``: the first column (in ``[0, W)``; the run may go past ``W - 1``
+    and wraps round to column 0) and the number of columns (at most ``W``) of each
+    triangle's span (:func:`triangle_spans`; 0 for those skipped), then ``(0, 0)``, for
+    ``W`` columns once round the circle at bearings ``first - j * step``; a little wider
+    than the span (each column is tested exactly). Branch-free: vectorised."""
     for t in range(corners.shape[1]):
         lo, hi, kind = _bearing_span(corners, normals, closed, t, origin[0], origin[1],
                                      origin[2], yaw)
-        j0 = int(math.ceil((first - hi) / step - _INDEX_SLACK))
-        j1 = int(math.floor((first - lo) / step + _INDEX_SLACK)) + 1
+        j0 = math.ceil((first - hi) / step - _INDEX_SLACK)
+        j1 = math.floor((first - lo) / step + _INDEX_SLACK) + 1
+        count = min(max(j1 - j0, 0.0), float(W))
+        j0 -= W * math.floor(j0 / W)                    # into [0, W): exact on integers
         everywhere = kind == EVERYWHERE
-        ranges[0, t] = 0 if everywhere else j0
-        ranges[1, t] = W if everywhere else (0 if kind == SKIP else max(j1 - j0, 0))
+        ranges[0, t] = 0 if everywhere else int(j0)
+        ranges[1, t] = W if everywhere else (0 if kind == SKIP else int(count))
         ranges[2, t] = 0
         ranges[3, t] = 0
 

@@ -96,3 +96,18 @@ def test_weights_are_written_only_where_the_shader_reads_them(rocks):
         np.testing.assert_allclose(all_weights[seen].sum(1), 1.0, atol=1e-9)
         none = np.zeros(len(mesh.triangles), np.bool_)
         assert np.isnan(_cast(mesh, pose, rays, weighted=none)[1]).all()
+
+
+@pytest.mark.parametrize("turns", [-3, -1, 1, 3])
+def test_any_heading_gives_the_picture_of_the_same_heading_within_one_turn(rocks, turns):
+    """A heading a whole number of turns away is the same camera: the panorama (columns by
+    arithmetic) and a pinhole view (columns by search) hit the same triangles, whatever
+    the heading's size. Before the bearings were wrapped a heading past pi sent the
+    panorama's columns out of the image (a write out of bounds: CI aborted)."""
+    mesh, poses = rocks
+    for rays in (panorama_rays((48, 256), math.radians(60), 1), perspective_rays(80, 60, 70.0)):
+        for x, y, yaw, height in poses[:4]:
+            near, _, _ = _cast(mesh, (x, y, yaw, height), rays)
+            far, _, _ = _cast(mesh, (x, y, yaw + 2 * math.pi * turns, height), rays)
+            assert (near >= 0).mean() > 0.4
+            assert (far != near).mean() < 1e-3          # cos(yaw + beta) rounds differently
