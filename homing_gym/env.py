@@ -18,7 +18,7 @@ import numpy as np
 from gymnasium import spaces
 
 from homing_gym.actions import DiscreteAction
-from homing_gym.geometry import to_frame
+from homing_gym.geometry import camera_pose, to_frame
 from homing_gym.observations import CORE_KEYS, ObservationKey, Sight, goal_step_key
 from homing_gym.panorama import CameraConfig, Lighting, PanoramaCamera, random_lighting
 from homing_gym.paths import occupancy
@@ -265,7 +265,7 @@ class HomingEnv(gym.Env):
     def render_panorama(self, pose) -> np.ndarray:
         """Panorama (uint8 HWC) the robot's camera would see at ``pose`` in the current
         world and the episode's lighting, rendered as is (the robot body stays where it is)."""
-        return self.camera.render(self.sim.client, pose, self._lighting)
+        return self.camera.render(self.sim.client, camera_pose(pose), self._lighting)
 
     def render_view(self, pose=None, size: tuple[int, int] = (640, 480),
                     hfov_deg: float = 60.0) -> np.ndarray:
@@ -275,8 +275,8 @@ class HomingEnv(gym.Env):
         horizontal field of view, under the episode's lighting. The world and the
         episode are left untouched (see :mod:`homing_gym.perspective`)."""
         config = PerspectiveConfig(width=size[0], height=size[1], hfov=math.radians(hfov_deg))
-        return render_perspective(self.sim.client, self.pose if pose is None else pose,
-                                  self.robot_config.camera_height, config,
+        pose = self.pose if pose is None else camera_pose(pose)
+        return render_perspective(self.sim.client, pose, self.robot_config.camera_height, config,
                                   self.sim.renderer, self._lighting, self.sim.caster)
 
     @property
@@ -393,11 +393,11 @@ class HomingEnv(gym.Env):
         (xmin, ymin), (xmax, ymax) = self.scene.bounds
         for key, value in options.items():
             try:
-                pose = np.asarray(value, dtype=np.float64)
-            except (TypeError, ValueError):
-                pose = np.full(1, np.nan)             # refused just below, with its name
-            if pose.shape != (3,) or not np.all(np.isfinite(pose)) or not (
-                    xmin <= pose[0] <= xmax and ymin <= pose[1] <= ymax):
+                pose = camera_pose(value)
+                inside = xmin <= pose[0] <= xmax and ymin <= pose[1] <= ymax
+            except ValueError:
+                inside = False                        # refused just below, with its name
+            if not inside:
                 raise ValueError(f"reset option {key}={value!r} must be a finite pose "
                                  f"(x, y, yaw) with x in [{xmin}, {xmax}], y in [{ymin}, {ymax}]")
             # the robot stands at the start; the home only needs to be in free space

@@ -25,3 +25,15 @@ def to_frame(pose_ref: np.ndarray, pose: np.ndarray) -> np.ndarray:
 def bearing_to(pose: np.ndarray, point) -> float:
     """Bearing (radians, CCW from the robot heading, in ``(-pi, pi]``) of a world point."""
     return wrap_angle(np.arctan2(point[1] - pose[1], point[0] - pose[0]) - pose[2])
+
+
+def camera_pose(pose) -> np.ndarray:
+    """``pose`` as a float array ``(x, y, yaw)`` (metres, radians), or a ``ValueError``
+    naming it when it is not three finite numbers (a NaN pose would render only sky)."""
+    try:
+        array = np.asarray(pose, dtype=np.float64)
+    except (TypeError, ValueError):
+        array = np.full(1, np.nan)
+    if array.shape != (3,) or not np.all(np.isfinite(array)):
+        raise ValueError(f"pose {pose!r} must be three finite numbers (x, y, yaw)")
+    return array

@@ -89,6 +89,17 @@ def test_reset_options_must_leave_the_robot_in_free_space(make_env, options, wor
     assert np.allclose(info["home_pose"], (0.2, -0.3, 1.0))
 
 
+@pytest.mark.parametrize("pose", [(np.nan, 0.0, 0.0), (0.0, 0.0, np.inf), (0.0, 0.0), "abc"])
+def test_pictures_at_a_pose_need_a_finite_pose(make_env, pose):
+    """Not a sky-only picture: a NaN pose is refused by name."""
+    env = make_env(panorama_shape=(16, 64)).unwrapped
+    env.reset(seed=0)
+    for render in (env.render_panorama, env.render_view):
+        with pytest.raises(ValueError, match="three finite numbers"):
+            render(pose)
+    assert env.render_panorama((0.0, 0.0, 0.0)).shape == (16, 64, 3)
+
+
 @pytest.mark.parametrize("env_id, jitter, words", [
     ("homing_gym/RouteFollowing-v0", 100.0, ["start_jitter 100.0 m", "route's start",
                                             "hallway", "at most 0.473 m fits"]),   # (0.85 - 0.18) / sqrt 2
