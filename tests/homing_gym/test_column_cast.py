@@ -1,6 +1,9 @@
 """The column caster's shortcuts: each gives exactly the hits of the plain search."""
 
 import math
+import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -111,3 +114,46 @@ def test_any_heading_gives_the_picture_of_the_same_heading_within_one_turn(rocks
             far, _, _ = _cast(mesh, (x, y, yaw + 2 * math.pi * turns, height), rays)
             assert (near >= 0).mean() > 0.4
             assert (far != near).mean() < 1e-3          # cos(yaw + beta) rounds differently
+
+
+#: Renders odd cameras (any heading, tiny to large images, 1-3 rays per pixel side,
+#: cameras outside the world, near the ground and above the walls) in a mesh world and
+#: two textured ones, with and without shadows.
+_ODD_CAMERAS = """
+import sys
+import numpy as np
+from homing_gym.benchmark import mesh_world
+from homing_gym.panorama import CameraConfig, Lighting
+from homing_gym.raycast import RayCaster
+from homing_gym.scenes import scene_factory
+from homing_gym.worldmesh import world_mesh
+rng = np.random.default_rng(0)
+for scene in (mesh_world(), scene_factory("hallway").build(rng),
+              scene_factory("random_rooms").build(rng)):
+    mesh = world_mesh(scene)
+    (xmin, ymin), (xmax, ymax) = scene.bounds
+    for shadows in (False, True):
+        caster = RayCaster(mesh, shadows=shadows)
+        for _ in range(25):
+            pose = (rng.uniform(xmin - 1, xmax + 1), rng.uniform(ymin - 1, ymax + 1),
+                    rng.uniform(-40, 40))
+            height = float(rng.choice([0.001, 0.01, 0.3, 2.0, 5.0]))
+            shape = (int(rng.integers(8, 40)), int(rng.integers(16, 300)))
+            config = CameraConfig(panorama_shape=shape, vfov=float(rng.uniform(0.18, 2.09)))
+            light = Lighting(direction=tuple(rng.normal(size=3) + [0, 0, 1.5]))
+            caster.panorama(pose, height, config, light, int(rng.integers(1, 4)))
+            caster.perspective(pose, height, int(rng.integers(1, 90)),
+                               int(rng.integers(1, 70)), float(rng.uniform(5, 300)), light,
+                               int(rng.integers(1, 3)))
+"""
+
+
+@pytest.mark.slow
+def test_the_caster_never_reads_or_writes_outside_its_arrays(tmp_path):
+    """numba does not check indices: a write out of bounds corrupts memory silently and
+    crashes later somewhere else. Compiled with bounds checks (``NUMBA_BOUNDSCHECK``, in
+    a fresh cache), odd cameras must render without an ``IndexError``."""
+    env = dict(os.environ, NUMBA_BOUNDSCHECK="1", NUMBA_CACHE_DIR=str(tmp_path))
+    run = subprocess.run([sys.executable, "-c", _ODD_CAMERAS], env=env, capture_output=True,
+                         text=True, timeout=600)
+    assert run.returncode == 0, run.stderr[-3000:]
