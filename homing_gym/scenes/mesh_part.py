@@ -63,8 +63,9 @@ class MeshPart:
             if uvs.shape != (len(vertices), 2) or not np.all(np.isfinite(uvs)):
                 raise ValueError(f"{owner}: uvs must be finite ({len(vertices)}, 2), "
                                  f"got shape {uvs.shape}")
-            if texture.ndim != 3 or texture.shape[2] != 3 or texture.dtype != np.uint8:
-                raise ValueError(f"{owner}: texture must be uint8 (H, W, 3), got "
+            if (texture.ndim != 3 or texture.shape[2] != 3 or texture.dtype != np.uint8
+                    or texture.size == 0):
+                raise ValueError(f"{owner}: texture must be uint8 (H, W, 3) with H, W >= 1, got "
                                  f"{texture.dtype} {texture.shape}")
             object.__setattr__(self, "uvs", uvs)
             object.__setattr__(self, "texture", texture)

@@ -9,6 +9,7 @@ import trimesh
 
 from homing_gym.scenes import MeshScene, scene_factory
 from homing_gym.scenes.base import clearance, clearances
+from homing_gym.scenes.mesh_part import MeshPart
 from homing_gym.scenes.mesh_example import (LEG_HALF, PILLAR, example_room_parts,
                                             write_example_room)
 from homing_gym.topdown import BG, MapCanvas, draw_scene
@@ -164,6 +165,12 @@ def test_bad_mesh_input_is_a_clear_error(tmp_path, room_files, make_env):
         MeshScene.from_arrays(tri, np.zeros((0, 3), int))
     with pytest.raises(ValueError, match="face indices"):
         MeshScene.from_arrays(tri, [[0, 1, 5]])
+    uvs, texel = np.zeros((3, 2)), np.zeros((1, 1, 3), np.uint8)
+    with pytest.raises(ValueError, match="uvs must be finite"):
+        MeshPart(tri, [[0, 1, 2]], [[1, 1, 1]], np.full((3, 2), np.nan), texel)
+    with pytest.raises(ValueError, match=r"H, W >= 1, got uint8 \(0, 4, 3\)"):
+        MeshPart(tri, [[0, 1, 2]], [[1, 1, 1]], uvs, np.zeros((0, 4, 3), np.uint8))
+    assert MeshPart(tri, [[0, 1, 2]], [[1, 1, 1]], uvs, texel).texture.shape == (1, 1, 3)
     with pytest.raises(ValueError, match="unknown option 'size'"):
         scene_factory(f"mesh:{room_files / 'room.obj'}?size=2")
     with pytest.raises(ValueError, match="up axis"):
