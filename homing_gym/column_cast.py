@@ -181,7 +181,7 @@ def _bearing_span(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray, 
     d1 = _approx_atan2(x0 * y1 - y0 * x1, x0 * x1 + y0 * y1)
     d2 = _approx_atan2(x0 * y2 - y0 * x2, x0 * x2 + y0 * y2)
     a0 = _approx_atan2(y0, x0) - yaw
-    a0 -= 2 * math.pi * math.floor((a0 + math.pi) / (2 * math.pi))   # into [-pi, pi)
+    a0 -= 2 * math.pi * np.floor((a0 + math.pi) * (0.5 / math.pi))   # into about [-pi, pi)
     return (a0 + min(min(d1, d2), 0.0) - _ATAN_SLACK, a0 + max(max(d1, d2), 0.0) + _ATAN_SLACK,
             (SPAN + around) * (1 - (away | edge_on)))
 
@@ -410,10 +410,10 @@ def _circle_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray
     for t in range(corners.shape[1]):
         lo, hi, kind = _bearing_span(corners, normals, closed, t, origin[0], origin[1],
                                      origin[2], yaw)
-        j0 = math.ceil((first - hi) / step - _INDEX_SLACK)
-        j1 = math.floor((first - lo) / step + _INDEX_SLACK) + 1
+        j0 = np.ceil((first - hi) / step - _INDEX_SLACK)           # whole numbers, as floats
+        j1 = np.floor((first - lo) / step + _INDEX_SLACK) + 1.0
         count = min(max(j1 - j0, 0.0), float(W))
-        j0 -= W * math.floor(j0 / W)                    # into [0, W): exact on integers
+        j0 -= W * np.floor(j0 / W)                      # into [0, W): exact on whole numbers
         everywhere = kind == EVERYWHERE
         ranges[0, t] = 0 if everywhere else int(j0)
         ranges[1, t] = W if everywhere else (0 if kind == SKIP else int(count))

@@ -251,7 +251,7 @@ class HomingEnv(gym.Env):
         move (observation keys ``panorama``, ``omni``, ``signature`` and the ``rgb_array``
         picture read it; an agent that observes only other keys costs no panorama)."""
         if self._panorama is None:
-            self._panorama = self.render_panorama(self.pose)
+            self._panorama = self.camera.render(self.sim.client, self.pose, self._lighting)
         return self._panorama
 
     def skip_next_images(self) -> None:
