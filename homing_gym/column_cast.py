@@ -445,8 +445,10 @@ def _searched_columns(lo: np.ndarray, hi: np.ndarray, kind: np.ndarray, beta: np
 def _texel(atlas: np.ndarray, levels: np.ndarray, m: int, s: float, v: float):
     """Bilinear sample (wrapped) of mip level ``levels[m] = (offset, height, width)`` at
     texture coordinates ``(s, v)`` (``v`` bottom to top): ``(r, g, b)``, returned in
-    registers rather than through memory."""
-    off, h, w = levels[m, 0], levels[m, 1], levels[m, 2]
+    registers rather than through memory. The indices are unsigned, so numba reads
+    without testing them for negative values (a tenth of a textured image's time)."""
+    level = np.uint64(m)
+    off, h, w = levels[level, 0], levels[level, 1], levels[level, 2]
     x = (s - math.floor(s)) * w - 0.5                # in [-0.5, w - 0.5)
     y = (math.ceil(v) - v) * h - 0.5                 # rows run top to bottom
     xa, ya = int(math.floor(x)), int(math.floor(y))  # in [-1, w - 1], [-1, h - 1]
@@ -460,10 +462,12 @@ def _texel(atlas: np.ndarray, levels: np.ndarray, m: int, s: float, v: float):
         ya += h
     if yb >= h:
         yb -= h
-    a, b = off + 3 * (ya * w + xa), off + 3 * (ya * w + xb)
-    c_, d = off + 3 * (yb * w + xa), off + 3 * (yb * w + xb)
-    return (_bilinear(atlas, a, b, c_, d, fx, fy), _bilinear(atlas, a + 1, b + 1, c_ + 1, d + 1, fx, fy),
-            _bilinear(atlas, a + 2, b + 2, c_ + 2, d + 2, fx, fy))
+    a, b = np.uint64(off + 3 * (ya * w + xa)), np.uint64(off + 3 * (ya * w + xb))
+    c, d = np.uint64(off + 3 * (yb * w + xa)), np.uint64(off + 3 * (yb * w + xb))
+    one, two = np.uint64(1), np.uint64(2)
+    return (_bilinear(atlas, a, b, c, d, fx, fy),
+            _bilinear(atlas, a + one, b + one, c + one, d + one, fx, fy),
+            _bilinear(atlas, a + two, b + two, c + two, d + two, fx, fy))
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -537,70 +541,125 @@ def shade(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.nd
 
     Cast shadows (:mod:`homing_gym.shadows`; off when ``shadow_depth`` is empty): a point
     in the shadow of the map takes ``shaded[t]`` (the ambient light alone) instead of
-    ``base[t]``."""
+    ``base[t]``.
+
+    Each ray column is shaded in two passes: lit colours, texture coordinates and levels
+    of detail (:func:`_lit_rays`), then the texture samples of the rays that need them
+    (:func:`_textured_rays`). A textured ray is a long chain of dependent steps; cut in
+    two short loops, the core works on several rays at once (the arithmetic, so every
+    pixel, is the same as in one loop)."""
     rows, cols = out.shape[0], out.shape[1]
-    k = hit.shape[0] // rows
+    H = hit.shape[0]
+    k = H // rows
     mean = np.float32(1.0 / (k * k))
-    shadows = shadow_depth.size > 0
     zero = np.float32(0.0)
+    color = np.empty((k, H, 3))         # the colours of one pixel column's rays
+    sample = np.empty((H, 3))           # (s, v, lod) of a ray column's textured rays
+    textured = np.empty(H, np.int64)    # and their rows
     for jo in range(cols):
+        for a in range(k):
+            j = jo * k + a
+            n = _lit_rays(hit, weights, base, texture, uvs, texel_density, tris, normals,
+                          origin, ray_spacing, sky, shaded, shadow_depth, shadow_axes,
+                          shadow_origin, shadow_cell, j, color[a], sample, textured)
+            _textured_rays(n, textured, sample, hit, j, texture, atlas, levels, first_level,
+                           texel_density, color[a])
         for io in range(rows):
             acc_r, acc_g, acc_b = zero, zero, zero        # in registers, not an array
             for i in range(io * k, io * k + k):
-                for j in range(jo * k, jo * k + k):
-                    t = hit[i, j]
-                    if t < 0:
-                        r, g, b = sky[0], sky[1], sky[2]
-                    else:
-                        r, g, b = base[t, 0], base[t, 1], base[t, 2]
-                        tex = texture[t]
-                        px = py = pz = 0.0
-                        if tex >= 0 or shadows:
-                            for c in range(3):
-                                px += weights[i, j, c] * tris[t, c, 0]
-                                py += weights[i, j, c] * tris[t, c, 1]
-                                pz += weights[i, j, c] * tris[t, c, 2]
-                        if shadows and (r, g, b) != (shaded[t, 0], shaded[t, 1], shaded[t, 2]):
-                            facing = (normals[t, 0] * shadow_axes[2, 0] + normals[t, 1] * shadow_axes[2, 1]
-                                      + normals[t, 2] * shadow_axes[2, 2])
-                            if in_shadow(shadow_depth, shadow_axes, shadow_origin, shadow_cell,
-                                         px, py, pz, facing):
-                                r, g, b = shaded[t, 0], shaded[t, 1], shaded[t, 2]
-                        if tex >= 0:
-                            s = v = 0.0
-                            for c in range(3):
-                                s += weights[i, j, c] * uvs[t, c, 0]
-                                v += weights[i, j, c] * uvs[t, c, 1]
-                            dx, dy, dz = px - origin[0], py - origin[1], pz - origin[2]
-                            length = math.sqrt(dx * dx + dy * dy + dz * dz)
-                            facing = abs(normals[t, 0] * dx + normals[t, 1] * dy + normals[t, 2] * dz)
-                            cos_in = max(facing / max(length, 1e-9), 0.1)
-                            texels = length * ray_spacing / cos_in * texel_density[t]
-                            lod = math.log2(texels) if texels > 1.0 else 0.0
-                            top = first_level[tex + 1] - first_level[tex] - 1
-                            lod = min(lod, float(top))
-                            m = int(lod)
-                            frac = lod - m
-                            base_level = first_level[tex]
-                            if texel_density[t] == 0.0:      # one texel spread over the face (no UVs)
-                                off, h, w = (levels[base_level, 0], levels[base_level, 1],
-                                             levels[base_level, 2])
-                                col = min(max(int((s % 1.0) * w), 0), w - 1)
-                                row = min(max(int((1.0 - v % 1.0) * h), 0), h - 1)
-                                at = off + 3 * (row * w + col)
-                                nr, ng, nb = float(atlas[at]), float(atlas[at + 1]), float(atlas[at + 2])
-                            else:
-                                nr, ng, nb = _texel(atlas, levels, base_level + m, s, v)
-                            if frac > 0.0 and m < top and texel_density[t] > 0.0:
-                                fr, fg, fb = _texel(atlas, levels, base_level + m + 1, s, v)
-                                nr = (1 - frac) * nr + frac * fr
-                                ng = (1 - frac) * ng + frac * fg
-                                nb = (1 - frac) * nb + frac * fb
-                            r, g, b = r * nr, g * ng, b * nb
-                        r, g, b = min(max(r, 0.0), 1.0), min(max(g, 0.0), 1.0), min(max(b, 0.0), 1.0)
-                    acc_r += np.float32(r)
-                    acc_g += np.float32(g)
-                    acc_b += np.float32(b)
+                for a in range(k):
+                    acc_r += np.float32(color[a, i, 0])
+                    acc_g += np.float32(color[a, i, 1])
+                    acc_b += np.float32(color[a, i, 2])
             out[io, jo, 0] = np.uint8(acc_r * mean * _SCALE_255 + _HALF)
             out[io, jo, 1] = np.uint8(acc_g * mean * _SCALE_255 + _HALF)
             out[io, jo, 2] = np.uint8(acc_b * mean * _SCALE_255 + _HALF)
+
+
+@njit(cache=True, error_model="numpy")
+def _lit_rays(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.ndarray,
+              uvs: np.ndarray, texel_density: np.ndarray, tris: np.ndarray,
+              normals: np.ndarray, origin: np.ndarray, ray_spacing: float, sky: np.ndarray,
+              shaded: np.ndarray, shadow_depth: np.ndarray, shadow_axes: np.ndarray,
+              shadow_origin: np.ndarray, shadow_cell: float, j: int, color: np.ndarray,
+              sample: np.ndarray, textured: np.ndarray) -> int:
+    """First pass of :func:`shade` over ray column ``j``: ``color[i]`` the sky, or the
+    lit (or shadowed) colour of the triangle hit, clipped unless it has a texture; for
+    the rays on a texture, their rows in ``textured`` and ``sample`` their texture
+    coordinates and level of detail. Returns how many rays are on a texture."""
+    shadows = shadow_depth.size > 0
+    n = 0
+    for i in range(hit.shape[0]):
+        t = hit[i, j]
+        if t < 0:
+            color[i, 0], color[i, 1], color[i, 2] = sky[0], sky[1], sky[2]
+            continue
+        r, g, b = base[t, 0], base[t, 1], base[t, 2]
+        tex = texture[t]
+        px = py = pz = 0.0
+        if tex >= 0 or shadows:
+            for c in range(3):
+                px += weights[i, j, c] * tris[t, c, 0]
+                py += weights[i, j, c] * tris[t, c, 1]
+                pz += weights[i, j, c] * tris[t, c, 2]
+        if shadows and (r, g, b) != (shaded[t, 0], shaded[t, 1], shaded[t, 2]):
+            facing = (normals[t, 0] * shadow_axes[2, 0] + normals[t, 1] * shadow_axes[2, 1]
+                      + normals[t, 2] * shadow_axes[2, 2])
+            if in_shadow(shadow_depth, shadow_axes, shadow_origin, shadow_cell,
+                         px, py, pz, facing):
+                r, g, b = shaded[t, 0], shaded[t, 1], shaded[t, 2]
+        if tex >= 0:
+            s = v = 0.0
+            for c in range(3):
+                s += weights[i, j, c] * uvs[t, c, 0]
+                v += weights[i, j, c] * uvs[t, c, 1]
+            dx, dy, dz = px - origin[0], py - origin[1], pz - origin[2]
+            length = math.sqrt(dx * dx + dy * dy + dz * dz)
+            facing = abs(normals[t, 0] * dx + normals[t, 1] * dy + normals[t, 2] * dz)
+            cos_in = max(facing / max(length, 1e-9), 0.1)
+            texels = length * ray_spacing / cos_in * texel_density[t]
+            sample[n, 0], sample[n, 1] = s, v
+            sample[n, 2] = math.log2(texels) if texels > 1.0 else 0.0
+            textured[n] = i
+            n += 1
+            color[i, 0], color[i, 1], color[i, 2] = r, g, b
+        else:
+            color[i, 0], color[i, 1], color[i, 2] = (min(max(r, 0.0), 1.0), min(max(g, 0.0), 1.0),
+                                                     min(max(b, 0.0), 1.0))
+    return n
+
+
+@njit(cache=True, error_model="numpy")
+def _textured_rays(n: int, textured: np.ndarray, sample: np.ndarray, hit: np.ndarray, j: int,
+                   texture: np.ndarray, atlas: np.ndarray, levels: np.ndarray,
+                   first_level: np.ndarray, texel_density: np.ndarray,
+                   color: np.ndarray) -> None:
+    """Second pass of :func:`shade`: the first ``n`` rays listed in ``textured`` (rows
+    of ray column ``j``) times their texture's filtered colour, clipped."""
+    for q in range(n):
+        i = textured[q]
+        t = hit[i, j]
+        tex = texture[t]
+        s, v, lod = sample[q, 0], sample[q, 1], sample[q, 2]
+        top = first_level[tex + 1] - first_level[tex] - 1
+        lod = min(lod, float(top))
+        m = int(lod)
+        frac = lod - m
+        base_level = first_level[tex]
+        if texel_density[t] == 0.0:      # one texel spread over the face (no UVs)
+            off, h, w = (levels[base_level, 0], levels[base_level, 1],
+                         levels[base_level, 2])
+            col = min(max(int((s % 1.0) * w), 0), w - 1)
+            row = min(max(int((1.0 - v % 1.0) * h), 0), h - 1)
+            at = off + 3 * (row * w + col)
+            nr, ng, nb = float(atlas[at]), float(atlas[at + 1]), float(atlas[at + 2])
+        else:
+            nr, ng, nb = _texel(atlas, levels, base_level + m, s, v)
+        if frac > 0.0 and m < top and texel_density[t] > 0.0:
+            fr, fg, fb = _texel(atlas, levels, base_level + m + 1, s, v)
+            nr = (1 - frac) * nr + frac * fr
+            ng = (1 - frac) * ng + frac * fg
+            nb = (1 - frac) * nb + frac * fb
+        r, g, b = color[i, 0] * nr, color[i, 1] * ng, color[i, 2] * nb
+        color[i, 0], color[i, 1], color[i, 2] = (min(max(r, 0.0), 1.0), min(max(g, 0.0), 1.0),
+                                                 min(max(b, 0.0), 1.0))
