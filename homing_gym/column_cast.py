@@ -445,29 +445,31 @@ def _searched_columns(lo: np.ndarray, hi: np.ndarray, kind: np.ndarray, beta: np
 def _texel(atlas: np.ndarray, levels: np.ndarray, m: int, s: float, v: float):
     """Bilinear sample (wrapped) of mip level ``levels[m] = (offset, height, width)`` at
     texture coordinates ``(s, v)`` (``v`` bottom to top): ``(r, g, b)``, returned in
-    registers rather than through memory. The indices are unsigned, so numba reads
-    without testing them for negative values (a tenth of a textured image's time)."""
+    registers rather than through memory. The level is stored with a border of one
+    texel wrapped round from the opposite side (:func:`texel_offset`), so the four
+    texels around any point are read without wrapping their indices; the indices are
+    unsigned, so numba reads without testing them for negative values."""
     level = np.uint64(m)
     off, h, w = levels[level, 0], levels[level, 1], levels[level, 2]
-    x = (s - math.floor(s)) * w - 0.5                # in [-0.5, w - 0.5)
-    y = (math.ceil(v) - v) * h - 0.5                 # rows run top to bottom
+    x = (s - np.floor(s)) * w - 0.5                  # in [-0.5, w - 0.5]
+    y = (np.ceil(v) - v) * h - 0.5                   # rows run top to bottom
     xa, ya = int(math.floor(x)), int(math.floor(y))  # in [-1, w - 1], [-1, h - 1]
     fx, fy = x - xa, y - ya
-    xb, yb = xa + 1, ya + 1
-    if xa < 0:
-        xa += w
-    if xb >= w:
-        xb -= w
-    if ya < 0:
-        ya += h
-    if yb >= h:
-        yb -= h
-    a, b = np.uint64(off + 3 * (ya * w + xa)), np.uint64(off + 3 * (ya * w + xb))
-    c, d = np.uint64(off + 3 * (yb * w + xa)), np.uint64(off + 3 * (yb * w + xb))
+    a = np.uint64(texel_offset(off, w, ya, xa))
+    b = a + np.uint64(3)
+    c = a + np.uint64(3 * (w + 2))
+    d = c + np.uint64(3)
     one, two = np.uint64(1), np.uint64(2)
     return (_bilinear(atlas, a, b, c, d, fx, fy),
             _bilinear(atlas, a + one, b + one, c + one, d + one, fx, fy),
             _bilinear(atlas, a + two, b + two, c + two, d + two, fx, fy))
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def texel_offset(off: int, w: int, row: int, col: int) -> int:
+    """Where texel ``(row, col)`` (from ``-1`` to the size: the border included) of a
+    level ``w`` texels wide, stored from ``off`` with its border, starts in the atlas."""
+    return off + 3 * ((row + 1) * (w + 2) + col + 1)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -534,7 +536,8 @@ def shade(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.nd
     at least 0.1), times the triangle's ``texel_density`` (texels per metre at full
     resolution) gives the level of detail ``log2`` of that many texels; the two mip levels
     around it are sampled bilinearly and blended. ``atlas`` holds every level of every
-    texture flattened one after another; ``levels[m] = (offset, height, width)`` of mip
+    texture flattened one after another, each with a border of one texel wrapped round
+    (:func:`texel_offset`); ``levels[m] = (offset, height, width)`` of mip
     level ``m``, texture ``k``'s levels from ``first_level[k]`` to ``first_level[k + 1]``
     (full resolution first, each half the size of the one before). A face whose UVs cover
     no area (one texel for the whole face) takes that texel.
@@ -651,7 +654,7 @@ def _textured_rays(n: int, textured: np.ndarray, sample: np.ndarray, hit: np.nda
                          levels[base_level, 2])
             col = min(max(int((s % 1.0) * w), 0), w - 1)
             row = min(max(int((1.0 - v % 1.0) * h), 0), h - 1)
-            at = off + 3 * (row * w + col)
+            at = texel_offset(off, w, row, col)
             nr, ng, nb = float(atlas[at]), float(atlas[at + 1]), float(atlas[at + 2])
         else:
             nr, ng, nb = _texel(atlas, levels, base_level + m, s, v)

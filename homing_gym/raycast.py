@@ -160,8 +160,10 @@ class RayCaster:
         self._everywhere = np.ones(len(self._texture), np.bool_)
         pyramids = [mip_levels(t) for t in mesh.textures]
         images = [level for pyramid in pyramids for level in pyramid]
-        offsets = np.concatenate([[0], np.cumsum([i.size for i in images])[:-1]]).astype(np.int64)
-        self._atlas = (np.concatenate([i.ravel() for i in images]).astype(np.float32)
+        # each level with a border of one texel wrapped round (see ``texel_offset``)
+        bordered = [np.pad(i, ((1, 1), (1, 1), (0, 0)), mode="wrap") for i in images]
+        offsets = np.concatenate([[0], np.cumsum([i.size for i in bordered])[:-1]]).astype(np.int64)
+        self._atlas = (np.concatenate([i.ravel() for i in bordered]).astype(np.float32)
                        if images else np.zeros(3, np.float32))
         self._levels = np.array([(o, i.shape[0], i.shape[1]) for o, i in zip(offsets, images)],
                                 np.int64).reshape(-1, 3)
