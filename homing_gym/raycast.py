@@ -47,6 +47,10 @@ from homing_gym.worldmesh import WorldMesh
 
 #: The shadow map of a caster without shadows (empty: ``shade`` skips the lookups).
 _NO_SHADOWS = ShadowMap(np.zeros((0, 0)), np.eye(3), np.zeros(2), 1.0)
+#: Largest texture atlas (bytes) kept in float64 rather than float32: the values are the
+#: same, and the shader reads float64 without a conversion (textured panoramas about 12%
+#: faster); a world with larger textures keeps float32, at half the memory.
+ATLAS_FLOAT64_BYTES = 64 * 2**20
 #: Colour of rays that hit nothing (RGB in [0, 1]); TinyRenderer's background is white.
 SKY_COLOR = (1.0, 1.0, 1.0)
 
@@ -118,6 +122,35 @@ def mip_levels(texture: np.ndarray) -> list[np.ndarray]:
     return levels
 
 
+class TextureAtlas(NamedTuple):
+    """Every mip level of every texture in one flat array, as :func:`shade` reads them:
+    ``atlas`` the levels' RGB values (in [0, 1]) one after another, each with a border
+    of one texel wrapped round from the opposite side
+    (:func:`~homing_gym.column_cast.texel_offset`); ``levels[m] = (offset, height,
+    width)`` of level ``m`` (its size without the border); texture ``k``'s levels from
+    ``first_level[k]`` to ``first_level[k + 1]``."""
+
+    atlas: np.ndarray
+    levels: np.ndarray
+    first_level: np.ndarray
+
+
+def texture_atlas(textures: list[np.ndarray]) -> TextureAtlas:
+    """The :class:`TextureAtlas` of ``textures`` (float RGB images): float32 values,
+    stored as float64 where that takes at most :data:`ATLAS_FLOAT64_BYTES`."""
+    pyramids = [mip_levels(t) for t in textures]
+    images = [level for pyramid in pyramids for level in pyramid]
+    bordered = [np.pad(i, ((1, 1), (1, 1), (0, 0)), mode="wrap") for i in images]
+    offsets = np.concatenate([[0], np.cumsum([i.size for i in bordered])[:-1]]).astype(np.int64)
+    atlas = (np.concatenate([i.ravel() for i in bordered]).astype(np.float32)
+             if images else np.zeros(3, np.float32))
+    levels = np.array([(o, i.shape[0], i.shape[1]) for o, i in zip(offsets, images)],
+                      np.int64).reshape(-1, 3)
+    first_level = np.concatenate([[0], np.cumsum([len(p) for p in pyramids])]).astype(np.int64)
+    return TextureAtlas(atlas.astype(np.float64) if atlas.size * 8 <= ATLAS_FLOAT64_BYTES
+                        else atlas, levels, first_level)
+
+
 def texel_density(mesh: WorldMesh) -> np.ndarray:
     """Texels per metre of each triangle's texture at full resolution (``(N,)``; 0 for
     untextured triangles): the square root of the texels its UVs cover over its area."""
@@ -158,17 +191,7 @@ class RayCaster:
         #: Triangles whose hits need barycentric weights (a texture; with shadows, all).
         self._textured = self._texture >= 0
         self._everywhere = np.ones(len(self._texture), np.bool_)
-        pyramids = [mip_levels(t) for t in mesh.textures]
-        images = [level for pyramid in pyramids for level in pyramid]
-        # each level with a border of one texel wrapped round (see ``texel_offset``)
-        bordered = [np.pad(i, ((1, 1), (1, 1), (0, 0)), mode="wrap") for i in images]
-        offsets = np.concatenate([[0], np.cumsum([i.size for i in bordered])[:-1]]).astype(np.int64)
-        self._atlas = (np.concatenate([i.ravel() for i in bordered]).astype(np.float32)
-                       if images else np.zeros(3, np.float32))
-        self._levels = np.array([(o, i.shape[0], i.shape[1]) for o, i in zip(offsets, images)],
-                                np.int64).reshape(-1, 3)
-        self._first_level = np.concatenate(
-            [[0], np.cumsum([len(p) for p in pyramids])]).astype(np.int64)
+        self._atlas, self._levels, self._first_level = texture_atlas(mesh.textures)
         self._texel_density = texel_density(mesh)
         #: Cast shadows (:mod:`homing_gym.shadows`); maps cached per light direction.
         self.shadows = shadows

@@ -242,3 +242,50 @@ def test_cast_shadows_darken_the_floor_behind_an_object_and_nothing_else(make_en
         assert pixel(shaded, x, y) == pytest.approx(pixel(plain, x, y), abs=1)
     with pytest.raises(ValueError, match="shadows needs renderer='raycast'"):
         make_env(renderer="tiny", shadows=True)
+
+
+@pytest.mark.parametrize("float64_bytes", [0, 2**30])
+def test_texture_samples_wrap_round_the_edges(monkeypatch, float64_bytes):
+    """Bilinear samples on the edge of a texture blend in the texels of the opposite edge
+    (the atlas stores each level with a wrapped border), in float32 and float64 atlases."""
+    from homing_gym import raycast
+    from homing_gym.column_cast import _texel
+
+    monkeypatch.setattr(raycast, "ATLAS_FLOAT64_BYTES", float64_bytes)
+    texture = np.arange(24, dtype=np.float32).reshape(2, 4, 3) / 24    # row 0 at the top
+    atlas = raycast.texture_atlas([texture])
+    assert atlas.atlas.dtype == (np.float64 if float64_bytes else np.float32)
+    assert atlas.levels[:, 1:].tolist() == [[2, 4], [1, 2], [1, 1]]
+    # v = 0.75: the centre of the top row; s = 0: halfway between the last and first columns
+    np.testing.assert_allclose(_texel(atlas.atlas, atlas.levels, 0, 0.0, 0.75),
+                               (texture[0, 3] + texture[0, 0]) / 2, rtol=1e-6)
+    # v = 1: halfway between the bottom and top rows; s = 1/8: the centre of column 0
+    np.testing.assert_allclose(_texel(atlas.atlas, atlas.levels, 0, 0.125, 1.0),
+                               (texture[1, 0] + texture[0, 0]) / 2, rtol=1e-6)
+    # a corner blends all four corners; whole turns away it is the same point
+    corners = (texture[0, 0] + texture[0, 3] + texture[1, 0] + texture[1, 3]) / 4
+    for s, v in [(0.0, 1.0), (3.0, -2.0), (-1.0, 5.0)]:
+        np.testing.assert_allclose(_texel(atlas.atlas, atlas.levels, 0, s, v), corners,
+                                   rtol=1e-6)
+
+
+def test_a_float32_atlas_gives_the_pixels_of_a_float64_one(monkeypatch):
+    """Worlds with large textures keep their atlas in float32 (half the memory): the
+    same values, so the same pixels."""
+    from homing_gym import raycast
+
+    env = gym.make("homing_gym/LocalHoming-v0", scene="hallway")
+    env.reset(seed=0)
+    u = env.unwrapped
+    caster, config = u.sim.caster, u.camera.config
+    env.close()
+    monkeypatch.setattr(raycast, "ATLAS_FLOAT64_BYTES", 0)
+    small = RayCaster(caster.mesh, caster.sky, shadows=True)
+    assert small._atlas.dtype == np.float32
+    monkeypatch.undo()
+    wide = RayCaster(caster.mesh, caster.sky, shadows=True)
+    assert wide._atlas.dtype == np.float64
+    for pose in [(0.3, 0.1, 0.4), (-1.0, 0.2, 2.5), (2.0, -0.1, -1.0)]:
+        assert np.array_equal(small.panorama(pose, 0.3, config), wide.panorama(pose, 0.3, config))
+        assert np.array_equal(small.perspective(pose, 0.3, 80, 60, 70.0),
+                              wide.perspective(pose, 0.3, 80, 60, 70.0))
