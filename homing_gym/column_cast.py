@@ -556,9 +556,9 @@ def shade(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.nd
     k = H // rows
     mean = np.float32(1.0 / (k * k))
     zero = np.float32(0.0)
-    color = np.empty((k, H, 3))         # the colours of one pixel column's rays
-    sample = np.empty((H, 3))           # (s, v, lod) of a ray column's textured rays
-    textured = np.empty(H, np.int64)    # and their rows
+    color = np.empty((k, H, 3), np.float32)    # the colours of one pixel column's rays
+    sample = np.empty((H, 6))     # (s, v, lod, lit r, g, b) of a ray column's textured rays
+    textured = np.empty(H, np.int64)           # and their rows
     for jo in range(cols):
         for a in range(k):
             j = jo * k + a
@@ -571,9 +571,9 @@ def shade(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.nd
             acc_r, acc_g, acc_b = zero, zero, zero        # in registers, not an array
             for i in range(io * k, io * k + k):
                 for a in range(k):
-                    acc_r += np.float32(color[a, i, 0])
-                    acc_g += np.float32(color[a, i, 1])
-                    acc_b += np.float32(color[a, i, 2])
+                    acc_r += color[a, i, 0]
+                    acc_g += color[a, i, 1]
+                    acc_b += color[a, i, 2]
             out[io, jo, 0] = np.uint8(acc_r * mean * _SCALE_255 + _HALF)
             out[io, jo, 1] = np.uint8(acc_g * mean * _SCALE_255 + _HALF)
             out[io, jo, 2] = np.uint8(acc_b * mean * _SCALE_255 + _HALF)
@@ -587,9 +587,9 @@ def _lit_rays(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: n
               shadow_origin: np.ndarray, shadow_cell: float, j: int, color: np.ndarray,
               sample: np.ndarray, textured: np.ndarray) -> int:
     """First pass of :func:`shade` over ray column ``j``: ``color[i]`` the sky, or the
-    lit (or shadowed) colour of the triangle hit, clipped unless it has a texture; for
-    the rays on a texture, their rows in ``textured`` and ``sample`` their texture
-    coordinates and level of detail. Returns how many rays are on a texture."""
+    lit (or shadowed) colour of the triangle hit, clipped; for the rays on a texture
+    instead their rows in ``textured`` and in ``sample`` their texture coordinates,
+    level of detail and lit colour. Returns how many rays are on a texture."""
     shadows = shadow_depth.size > 0
     n = 0
     for i in range(hit.shape[0]):
@@ -623,12 +623,11 @@ def _lit_rays(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: n
             texels = length * ray_spacing / cos_in * texel_density[t]
             sample[n, 0], sample[n, 1] = s, v
             sample[n, 2] = math.log2(texels) if texels > 1.0 else 0.0
+            sample[n, 3], sample[n, 4], sample[n, 5] = r, g, b
             textured[n] = i
             n += 1
-            color[i, 0], color[i, 1], color[i, 2] = r, g, b
         else:
-            color[i, 0], color[i, 1], color[i, 2] = (min(max(r, 0.0), 1.0), min(max(g, 0.0), 1.0),
-                                                     min(max(b, 0.0), 1.0))
+            _set_clipped(color, i, r, g, b)
     return n
 
 
@@ -637,8 +636,9 @@ def _textured_rays(n: int, textured: np.ndarray, sample: np.ndarray, hit: np.nda
                    texture: np.ndarray, atlas: np.ndarray, levels: np.ndarray,
                    first_level: np.ndarray, texel_density: np.ndarray,
                    color: np.ndarray) -> None:
-    """Second pass of :func:`shade`: the first ``n`` rays listed in ``textured`` (rows
-    of ray column ``j``) times their texture's filtered colour, clipped."""
+    """Second pass of :func:`shade`: ``color`` of the first ``n`` rays listed in
+    ``textured`` (rows of ray column ``j``), their lit colour times their texture's
+    filtered colour, clipped."""
     for q in range(n):
         i = textured[q]
         t = hit[i, j]
@@ -663,6 +663,12 @@ def _textured_rays(n: int, textured: np.ndarray, sample: np.ndarray, hit: np.nda
             nr = (1 - frac) * nr + frac * fr
             ng = (1 - frac) * ng + frac * fg
             nb = (1 - frac) * nb + frac * fb
-        r, g, b = color[i, 0] * nr, color[i, 1] * ng, color[i, 2] * nb
-        color[i, 0], color[i, 1], color[i, 2] = (min(max(r, 0.0), 1.0), min(max(g, 0.0), 1.0),
-                                                 min(max(b, 0.0), 1.0))
+        _set_clipped(color, i, sample[q, 3] * nr, sample[q, 4] * ng, sample[q, 5] * nb)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _set_clipped(color: np.ndarray, i: int, r: float, g: float, b: float) -> None:
+    """``color[i] = (r, g, b)`` clipped to ``[0, 1]`` (stored in float32, the precision
+    :func:`shade` sums them in)."""
+    color[i, 0], color[i, 1], color[i, 2] = (min(max(r, 0.0), 1.0), min(max(g, 0.0), 1.0),
+                                             min(max(b, 0.0), 1.0))
