@@ -579,7 +579,7 @@ def shade(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.nd
             out[io, jo, 2] = np.uint8(acc_b * mean * _SCALE_255 + _HALF)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _lit_rays(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.ndarray,
               uvs: np.ndarray, texel_density: np.ndarray, tris: np.ndarray,
               normals: np.ndarray, origin: np.ndarray, ray_spacing: float, sky: np.ndarray,
@@ -631,7 +631,7 @@ def _lit_rays(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: n
     return n
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _textured_rays(n: int, textured: np.ndarray, sample: np.ndarray, hit: np.ndarray, j: int,
                    texture: np.ndarray, atlas: np.ndarray, levels: np.ndarray,
                    first_level: np.ndarray, texel_density: np.ndarray,
