@@ -18,7 +18,7 @@ import numpy as np
 from gymnasium import spaces
 
 from homing_gym.actions import DiscreteAction
-from homing_gym.geometry import camera_pose, to_frame
+from homing_gym.geometry import finite_pose, to_frame
 from homing_gym.observations import CORE_KEYS, ObservationKey, Sight, goal_step_key
 from homing_gym.panorama import CameraConfig, Lighting, PanoramaCamera, random_lighting
 from homing_gym.paths import occupancy
@@ -265,7 +265,7 @@ class HomingEnv(gym.Env):
     def render_panorama(self, pose) -> np.ndarray:
         """Panorama (uint8 HWC) the robot's camera would see at ``pose`` in the current
         world and the episode's lighting, rendered as is (the robot body stays where it is)."""
-        return self.camera.render(self.sim.client, camera_pose(pose), self._lighting)
+        return self.camera.render(self.sim.client, finite_pose(pose), self._lighting)
 
     def render_view(self, pose=None, size: tuple[int, int] = (640, 480),
                     hfov_deg: float = 60.0) -> np.ndarray:
@@ -275,7 +275,7 @@ class HomingEnv(gym.Env):
         horizontal field of view, under the episode's lighting. The world and the
         episode are left untouched (see :mod:`homing_gym.perspective`)."""
         config = PerspectiveConfig(width=size[0], height=size[1], hfov=math.radians(hfov_deg))
-        pose = self.pose if pose is None else camera_pose(pose)
+        pose = self.pose if pose is None else finite_pose(pose)
         return render_perspective(self.sim.client, pose, self.robot_config.camera_height, config,
                                   self.sim.renderer, self._lighting, self.sim.caster)
 
@@ -393,7 +393,7 @@ class HomingEnv(gym.Env):
         (xmin, ymin), (xmax, ymax) = self.scene.bounds
         for key, value in options.items():
             try:
-                pose = camera_pose(value)
+                pose = finite_pose(value)
                 inside = xmin <= pose[0] <= xmax and ymin <= pose[1] <= ymax
             except ValueError:
                 inside = False                        # refused just below, with its name

@@ -27,9 +27,9 @@ def bearing_to(pose: np.ndarray, point) -> float:
     return wrap_angle(np.arctan2(point[1] - pose[1], point[0] - pose[0]) - pose[2])
 
 
-def camera_pose(pose) -> np.ndarray:
+def finite_pose(pose) -> np.ndarray:
     """``pose`` as a float array ``(x, y, yaw)`` (metres, radians), or a ``ValueError``
-    naming it when it is not three finite numbers (a NaN pose would render only sky)."""
+    naming it when it is not three finite numbers (a NaN camera pose renders only sky)."""
     try:
         array = np.asarray(pose, dtype=np.float64)
     except (TypeError, ValueError):
