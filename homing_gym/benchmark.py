@@ -15,7 +15,8 @@ Worlds: ``arena`` (Yu & Kim's arena, 1,074 triangles, untextured), ``hallway`` (
 corridor: every wall, door and poster textured, so most rays sample a texture), ``forest10k`` (40 trees as
 64-sided prisms of random size in a walled 10 m square, 10,290 triangles) and
 ``mesh10k`` (a mesh world: 30 lumpy rocks and four walls of triangles, 9,650 triangles
-and the floor, :func:`mesh_world`). With
+and the floor, :func:`mesh_world`), ``grass10k`` and ``grass50k`` (tussock grass of
+10,000 and 50,000 thin blades the robot drives through, :func:`grass_world`). With
 ``tiny`` at 48 x 256 in the arena, homing-gym 0.1's default physics steps of 1/240 s
 (``physics_substeps=24``) are measured too.
 
@@ -88,9 +89,44 @@ def mesh_world(rocks: int = 30, seed: int = 0) -> MeshScene:
                                  name="mesh10k", bounds=((-5, -5), (5, 5)), fence=False)
 
 
+def grass_world(blades: int = 10_000, seed: int = 0) -> MeshScene:
+    """A 10 m square of tussock grass the robot drives through (no collision, fenced):
+    ``blades`` blades, one thin triangle each (1-4 cm wide at the ground, 5-90 cm tall,
+    leaning up to a fifth of their height outwards), in clumps of 10-60 of up to 15 cm
+    radius, on a brown floor."""
+    rng = np.random.default_rng(seed)
+    sizes = []
+    while sum(sizes) < blades:
+        sizes.append(int(rng.integers(10, 61)))
+    sizes[-1] -= sum(sizes) - blades
+    clump = np.repeat(np.arange(len(sizes)), sizes)
+    centre = rng.uniform(-4.9, 4.9, (len(sizes), 2))[clump]
+    tallest = rng.uniform(0.2, 0.9, len(sizes))[clump]
+    offset = rng.uniform(0, 0.15, blades)[:, None] * _unit(rng.uniform(0, 2 * np.pi, blades))
+    foot = centre + offset
+    width = rng.uniform(0.01, 0.04, blades)[:, None] * _unit(rng.uniform(0, 2 * np.pi, blades))
+    height = rng.uniform(0.05, 1.0, blades) * (tallest - 0.05) + 0.05
+    outwards = offset / np.maximum(np.linalg.norm(offset, axis=1, keepdims=True), 1e-9)
+    lean = rng.uniform(0, 0.2, blades)[:, None] * height[:, None] * outwards
+    zero = np.zeros((blades, 1))
+    vertices = np.stack([np.hstack([foot - width / 2, zero]), np.hstack([foot + width / 2, zero]),
+                         np.hstack([foot + lean, height[:, None]])], 1).reshape(-1, 3)
+    colors = np.column_stack([rng.uniform(0.2, 0.5, blades), rng.uniform(0.45, 0.8, blades),
+                              rng.uniform(0.1, 0.3, blades)])
+    return MeshScene.from_arrays(vertices, np.arange(3 * blades).reshape(-1, 3), colors,
+                                 collision=False, name=f"grass{blades // 1000}k",
+                                 bounds=((-5, -5), (5, 5)), ground_color=(0.45, 0.35, 0.2, 1.0))
+
+
+def _unit(angle: np.ndarray) -> np.ndarray:
+    """Unit vectors ``(n, 2)`` at the angles ``angle`` (radians)."""
+    return np.column_stack([np.cos(angle), np.sin(angle)])
+
+
 #: Worlds measured: scene kwargs.
 WORLDS = {"arena": {}, "hallway": {"scene": "hallway"}, "forest10k": {"scene": forest_scene()},
-          "mesh10k": {"scene": mesh_world()}}
+          "mesh10k": {"scene": mesh_world()}, "grass10k": {"scene": grass_world(10_000)},
+          "grass50k": {"scene": grass_world(50_000)}}
 #: The procedural scenes whose resets ``--resets`` times.
 RESET_SCENES = ("random_arena", "random_rooms", "random_nature")
 
