@@ -12,9 +12,11 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import json
 import os
 import re
 import sys
+from typing import Any
 
 #: Comma-separated modules that ``import homing_gym`` imports (set by ``--import``).
 IMPORT_VARIABLE = "HOMING_GYM_IMPORT"
@@ -46,6 +48,47 @@ def seed_value(text: str) -> int:
     if seed < 0:
         raise argparse.ArgumentTypeError(f"a seed is an integer >= 0, got {text!r}")
     return seed
+
+
+def parse_json_kwargs(text: str | None, option: str = "--env-kwargs") -> dict[str, Any]:
+    """The JSON object ``text`` given to ``option`` (``{}`` for none); ``ValueError``
+    naming the option otherwise."""
+    if not text:
+        return {}
+    try:
+        value = json.loads(text)
+    except json.JSONDecodeError as err:
+        raise ValueError(f"{option} must be a JSON object, e.g. '{{\"success_on\": \"stop\"}}' "
+                         f"({err})") from None
+    if not isinstance(value, dict):
+        raise ValueError(f"{option} must be a JSON object, got {text!r}")
+    return value
+
+
+def add_env_arguments(parser: argparse.ArgumentParser, default_env: str) -> None:
+    """The options that pick the world of a command, the same everywhere: ``--env ID``,
+    ``--env-kwargs JSON`` and ``--scene SCENE`` (a built-in or ``--import``-registered
+    scene name, or ``mesh:PATH``; shorthand for ``"scene"`` in ``--env-kwargs``). Read
+    them with :func:`env_kwargs_from_args`."""
+    parser.add_argument("--env", default=default_env, help="env id")
+    parser.add_argument("--env-kwargs", default=None, metavar="JSON",
+                        help="keyword arguments of gym.make, a JSON object, e.g. "
+                        "'{\"scene\": \"lab\", \"success_on\": \"stop\"}'")
+    parser.add_argument("--scene", default=None, metavar="SCENE",
+                        help="the scene: a scene name (also one registered by --import) or "
+                        "mesh:PATH; the same as {\"scene\": SCENE} in --env-kwargs")
+
+
+def env_kwargs_from_args(args: argparse.Namespace) -> dict[str, Any]:
+    """``--env-kwargs`` with ``--scene`` in it (:func:`add_env_arguments`); ``ValueError``
+    if both name a scene."""
+    kwargs = parse_json_kwargs(args.env_kwargs)
+    if args.scene is not None:
+        if "scene" in kwargs:
+            raise ValueError(f"--scene {args.scene!r} and --env-kwargs' scene "
+                             f"{kwargs['scene']!r}: give the scene once")
+        kwargs["scene"] = args.scene
+    return kwargs
 
 
 def plain(text: str) -> str:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
 from collections.abc import Sequence
 
 import numpy as np
@@ -15,6 +16,7 @@ from homing_gym.scenes.base import Scene, clearance
 from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.base import Episode, check_start_jitter
 from homing_gym.tasks.goal_reaching import GoalReachingTask, RewardConfig
+from homing_gym.tasks.route_file import load_route
 from homing_gym.validation import require_positive
 
 #: The straight route's defaults: Hong et al.'s 17 targets 1 ft apart.
@@ -80,7 +82,8 @@ class RouteFollowingTask(GoalReachingTask):
                  start_jitter: tuple[float, float] = (0.05, math.radians(10)),
                  success_radius: float = 0.1, success_on: str = "reach",
                  reward: RewardConfig = RewardConfig(), clearance_margin: float = 0.18,
-                 route: Sequence[Sequence[float]] | None = None):
+                 route: Sequence[Sequence[float]] | str | os.PathLike | None = None):
+        route = load_route(route)                       # a path: the points of its file
         if not (isinstance(n_targets, (int, np.integer)) and n_targets >= 1):
             raise ValueError(f"n_targets must be an integer >= 1, got {n_targets!r}")
         require_positive("spacing", spacing, "metres")

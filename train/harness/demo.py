@@ -1,4 +1,5 @@
-"""``homing-demo``: one LocalHoming-v0 episode as pictures.
+"""``homing-demo``: one episode as pictures (LocalHoming-v0 in the arena unless
+``--env``, ``--env-kwargs`` or ``--scene`` say otherwise).
 
 Writes into ``--out``:
 
@@ -27,9 +28,14 @@ import numpy as np  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
 import homing_gym  # noqa: E402,F401
-from homing_gym.cli import command_parser, seed_value  # noqa: E402
+from homing_gym.cli import (add_env_arguments, command_parser,  # noqa: E402
+                            env_kwargs_from_args, seed_value)
 from homing_gym.panorama import bearing_column  # noqa: E402
+from homing_train import DEFAULT_ENV  # noqa: E402
 from homing_train.harness.rollout import prepare_policy, rollout  # noqa: E402
+
+#: The observation keys the views figure shows (added to any ``obs_keys`` given).
+VIEW_KEYS = ("panorama", "goal", "omni", "signature")
 
 
 def run_episode(env: gym.Env, seed: int, controller_name: str = "oracle"):
@@ -86,12 +92,13 @@ def main(argv: list[str] | None = None) -> int:
     parser = command_parser("homing-demo", __doc__)
     parser.add_argument("--out", default="demo", help="output folder")
     parser.add_argument("--seed", type=seed_value, default=9)
-    parser.add_argument("--scene", default="arena")
+    add_env_arguments(parser, DEFAULT_ENV)
     args = parser.parse_args(argv)
     try:
-        env = gym.make("homing_gym/LocalHoming-v0", scene=args.scene, render_mode="rgb_array",
-                       obs_keys=("panorama", "goal", "omni", "signature"))
-    except ValueError as err:
+        kwargs = env_kwargs_from_args(args)
+        kwargs["obs_keys"] = tuple(dict.fromkeys([*kwargs.get("obs_keys", ()), *VIEW_KEYS]))
+        env = gym.make(args.env, render_mode="rgb_array", **kwargs)
+    except (ValueError, gym.error.Error) as err:
         parser.error(str(err))
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -103,7 +110,7 @@ def main(argv: list[str] | None = None) -> int:
         views_figure(env, args.seed, out / "views.png")
     finally:
         env.close()
-    outcome = "reached home" if info["is_success"] else "did not reach home"
+    outcome = "reached the goal" if info["is_success"] else "did not reach the goal"
     print(f"episode {args.seed}: {outcome} in {len(frames) - 1} steps, final distance "
           f"{info['distance_to_goal']:.3f} m; wrote {out}/demo.png, demo.gif, views.png")
     return 0

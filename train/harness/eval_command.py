@@ -6,9 +6,11 @@
 
 With ``--protocol NAME`` (:mod:`homing_train.harness.protocols`) the protocol fixes the
 envs, env kwargs, episodes and the success rule (stop within the radius); ``--episodes``
-then counts per setting (default: the protocol's), each setting's results go to the
-folder ``NAME`` beside ``--out`` (without its extension) and ``--out`` gets the cell:
-the summary over all settings.
+then counts per setting (default: the protocol's), ``--seed S`` draws the protocol's
+episodes from base seed ``S`` instead of its own (recorded as ``"canonical_draw": false``
+and said in the summary), each setting's results go to the folder ``NAME`` beside
+``--out`` (without its extension) and ``--out`` gets the cell: the summary over all
+settings.
 """
 
 from __future__ import annotations
@@ -18,11 +20,10 @@ import os
 import sys
 from pathlib import Path
 
-from homing_gym.cli import command_parser
+from homing_gym.cli import command_parser, env_kwargs_from_args
 from homing_train.harness.evaluate import (DEFAULT_ENV, add_backend_arguments,
                                            add_policy_arguments, evaluate,
-                                           format_summary, parse_json_kwargs, policy_from_args,
-                                           stream_path)
+                                           format_summary, policy_from_args, stream_path)
 from homing_train.harness.matrix import run_cell
 from homing_train.harness.policies import recorded_settings
 from homing_train.harness.protocols import PROTOCOLS, protocol
@@ -30,10 +31,12 @@ from homing_train.harness.protocols import PROTOCOLS, protocol
 
 def _protocol_cell(args) -> int:
     """``--protocol``: run the cell and print its summary."""
-    if args.env != DEFAULT_ENV or args.env_kwargs or args.seed != 0 or args.param:
-        raise ValueError("--protocol fixes the env, its kwargs, the seeds and the method's "
-                         "parameters; drop --env/--env-kwargs/--seed/--param")
+    if args.env != DEFAULT_ENV or args.env_kwargs or args.scene or args.param:
+        raise ValueError("--protocol fixes the env, its kwargs and the method's parameters; "
+                         "drop --env/--env-kwargs/--scene/--param")
     chosen = protocol(args.protocol)
+    if args.seed is not None:
+        chosen = chosen.reseeded(args.seed)
     folder = Path(os.path.splitext(args.out)[0])
     if folder == Path(args.out):        # the cell's file and its settings' folder would clash
         raise ValueError(f"--out {args.out!r} needs an extension with --protocol, e.g. "
@@ -41,7 +44,10 @@ def _protocol_cell(args) -> int:
     cell = run_cell(chosen, args.policy, folder, args.episodes, args.workers,
                     progress=not args.quiet, resume=args.resume, backend=args.backend,
                     address=args.ray_address)
-    Path(args.out).write_text((folder / "cell.json").read_text())
+    doc = {**json.loads((folder / "cell.json").read_text()), "seed": chosen.seed,
+           "canonical_draw": chosen.canonical}
+    for path in (folder / "cell.json", Path(args.out)):
+        path.write_text(json.dumps(doc, indent=1))
     s = cell.summary
     print(f"{args.policy} on {chosen.label}: {s['episodes']} episodes, success (stopped "
           f"within the radius) {100 * s['success_rate']:.1f}% "
@@ -77,7 +83,7 @@ def main(argv: list[str] | None = None) -> int:
             return _protocol_cell(args)
         spec = policy_from_args(args)
         result = evaluate(spec, args.env, 100 if args.episodes is None else args.episodes,
-                          args.seed, parse_json_kwargs(args.env_kwargs), args.workers,
+                          args.seed or 0, env_kwargs_from_args(args), args.workers,
                           bin_width=args.bin_width, progress=not args.quiet,
                           stream=stream_path(args.out), resume=args.resume,
                           backend=args.backend, address=args.ray_address)

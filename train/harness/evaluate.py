@@ -28,7 +28,8 @@ import numpy as np
 from tqdm import tqdm
 
 import homing_gym
-from homing_gym.cli import seed_value
+from homing_gym.cli import add_env_arguments, parse_json_kwargs, seed_value  # noqa: F401
+# (parse_json_kwargs: homing_train.learning.saturation imports it from here)
 from homing_gym.validation import require_positive
 from homing_gym.env import simulation_settings
 from homing_gym.paths import NoPathError, path_length, shortest_path
@@ -65,6 +66,18 @@ class EpisodeRecord:
     final_heading_error_deg: float
     wall_time: float
     trajectory: list[list[float]] = field(default_factory=list, repr=False)
+    # on a route (None elsewhere; metrics.targets_reached_in_order)
+    targets: int | None = None                   # targets on the route
+    target_errors: list[float] | None = None     # the env's: distance each was left at (m)
+    targets_finished: int | None = None          # targets left (len(target_errors))
+    targets_reached: int | None = None           # reached in order, within the radius
+    all_targets_within_radius: bool | None = None  # every target left within the radius
+
+    @property
+    def reached(self) -> bool | None:
+        """On a route, whether every target was reached in order; elsewhere ``None``
+        (:func:`summarize` then uses ``min_distance``)."""
+        return None if self.targets is None else self.targets_reached == self.targets
 
 
 @dataclass
@@ -159,7 +172,9 @@ def summarize(episodes: Sequence[EpisodeRecord], bin_width: float = 0.3,
               seed: int = 0, radius: float = 0.15) -> dict[str, Any]:
     """Means with 95% CIs (success: Wilson; the others: seeded percentile bootstrap of the
     mean), success by start-distance bin, and ``reached_rate``: the share of episodes
-    that came within ``radius`` metres of the goal at any time (stopped there or not)."""
+    that came within ``radius`` metres of the goal at any time (stopped there or not); on
+    a route, that reached every target in order (:attr:`EpisodeRecord.reached`), and the
+    route's own means (:func:`route_summary`)."""
     if not episodes:
         raise ValueError("no episodes to summarize")
 
@@ -177,7 +192,8 @@ def summarize(episodes: Sequence[EpisodeRecord], bin_width: float = 0.3,
         ci_key = "success_ci" if key == "success_rate" else key.removesuffix("_mean") + "_ci"
         out[ci_key] = list(metrics.wilson_interval(int(values.sum()), values.size)
                            if key == "success_rate" else metrics.bootstrap_ci(values, seed=seed))
-    reached = int(np.sum(col("min_distance") <= radius))
+    reached = sum(e.min_distance <= radius if e.reached is None else e.reached
+                  for e in episodes)
     out["reached_rate"] = reached / len(episodes)
     out["reached_ci"] = list(metrics.wilson_interval(reached, len(episodes)))
     final_cm = 100 * col("final_distance")
@@ -188,7 +204,28 @@ def summarize(episodes: Sequence[EpisodeRecord], bin_width: float = 0.3,
     out["bin_width"] = bin_width
     out["success_by_distance"] = [asdict(b) for b in metrics.distance_bins(
         col("start_distance"), col("success"), bin_width)]
-    return out
+    return out | route_summary(episodes, seed)
+
+
+def route_summary(episodes: Sequence[EpisodeRecord], seed: int = 0) -> dict[str, Any]:
+    """Over the route episodes among ``episodes`` (none: ``{}``): ``targets_reached_fraction``
+    (mean share of each route's targets reached in order, bootstrap CI),
+    ``all_targets_within_radius_rate`` (Wilson CI), ``targets_finished_mean`` and the
+    mean and median error (m, cm) over every target left, ``None`` if none was."""
+    routes = [e for e in episodes if e.targets is not None]
+    if not routes:
+        return {}
+    fraction = np.array([e.targets_reached / e.targets for e in routes])
+    within = sum(bool(e.all_targets_within_radius) for e in routes)
+    errors = np.array([x for e in routes for x in e.target_errors])
+    return {"route_episodes": len(routes),
+            "targets_reached_fraction": float(fraction.mean()),
+            "targets_reached_fraction_ci": list(metrics.bootstrap_ci(fraction, seed=seed)),
+            "all_targets_within_radius_rate": within / len(routes),
+            "all_targets_within_radius_ci": list(metrics.wilson_interval(within, len(routes))),
+            "targets_finished_mean": float(np.mean([e.targets_finished for e in routes])),
+            "target_error_mean": float(errors.mean()) if errors.size else None,
+            "target_error_cm_median": float(100 * np.median(errors)) if errors.size else None}
 
 
 # -- running episodes ---------------------------------------------------------------------
@@ -221,6 +258,7 @@ def run_episode(env: gym.Env, policy, seed: int, start: Sequence[float] | None =
     final_geodesic = _geodesic(scene, final, home, radius)
     p = path_length(traj)
     success = bool(run.info.get("is_success", False))
+    route = _route_fields(run.info, run.poses[:, :2], unwrapped)
     return EpisodeRecord(
         seed=int(seed), start_pose=[round(float(v), 4) for v in start_pose],
         home_pose=[round(float(v), 4) for v in home],
@@ -233,7 +271,22 @@ def run_episode(env: gym.Env, policy, seed: int, start: Sequence[float] | None =
         soft_spl=metrics.soft_spl(final_geodesic, shortest, p),
         final_heading_error_deg=abs(math.degrees(wrap_angle(final[2] - home[2]))),
         wall_time=time.perf_counter() - t0,
-        trajectory=np.round(traj, 3).tolist())
+        trajectory=np.round(traj, 3).tolist(), **route)
+
+
+def _route_fields(info: dict, positions: np.ndarray, unwrapped) -> dict[str, Any]:
+    """The route fields of :class:`EpisodeRecord` from a route env's last ``info`` (its
+    ``target_errors``), the recorded positions, and the episode's goals and success
+    radius (public attributes); none for an env that reports no ``target_errors``."""
+    if "target_errors" not in info:
+        return {}
+    goals, radius = unwrapped.episode.goals, unwrapped.task.success_radius
+    errors = [float(e) for e in info["target_errors"]]
+    return {"targets": len(goals), "target_errors": errors, "targets_finished": len(errors),
+            "targets_reached": metrics.targets_reached_in_order(
+                positions, [g[:2] for g in goals], radius),
+            "all_targets_within_radius": len(errors) == len(goals)
+            and all(e < radius for e in errors)}
 
 
 _WORKER: dict[str, Any] = {}
@@ -545,24 +598,12 @@ def stream_path(out: str) -> str:
 
 
 # -- command line ---------------------------------------------------------------------------
-def parse_json_kwargs(text: str | None, option: str = "--env-kwargs") -> dict[str, Any]:
-    """Parse a JSON object given on the command line."""
-    if not text:
-        return {}
-    try:
-        value = json.loads(text)
-    except json.JSONDecodeError as err:
-        raise ValueError(f"{option} must be a JSON object, e.g. '{{\"success_on\": \"stop\"}}' "
-                         f"({err})") from None
-    if not isinstance(value, dict):
-        raise ValueError(f"{option} must be a JSON object, got {text!r}")
-    return value
-
-
 def add_policy_arguments(parser: argparse.ArgumentParser,
                          controllers_only: bool = False) -> None:
-    """The ``--policy/--param/--env/--env-kwargs/--seed/--workers`` options
-    (``controllers_only``: the command takes scripted controllers, not model zips)."""
+    """The ``--policy/--param/--seed/--workers`` options and the world's
+    (:func:`homing_gym.cli.add_env_arguments`: ``--env/--env-kwargs/--scene``);
+    ``controllers_only``: the command takes scripted controllers, not model zips.
+    ``--seed`` is ``None`` unless given (a protocol has its own)."""
     parser.add_argument("--policy", required=True,
                         help="registered scripted controller name" if controllers_only else
                         "registered controller name or path to a stable-baselines3 .zip")
@@ -570,10 +611,10 @@ def add_policy_arguments(parser: argparse.ArgumentParser,
                         help="controller parameter override (repeatable)" + (
                             "" if controllers_only else "; for an SB3 model only "
                             "deterministic=false (sample actions, seeded per episode)"))
-    parser.add_argument("--env", default=DEFAULT_ENV, help="env id")
-    parser.add_argument("--env-kwargs", default=None, metavar="JSON",
-                        help="keyword arguments of gym.make, a JSON object")
-    parser.add_argument("--seed", type=seed_value, default=0, help="seed of the first episode")
+    add_env_arguments(parser, DEFAULT_ENV)
+    parser.add_argument("--seed", type=seed_value, default=None,
+                        help="seed of the first episode (default 0; with --protocol: the "
+                        "base seed of the protocol's episode draw, default its own)")
     parser.add_argument("--workers", type=int, default=1, help="parallel processes")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--trust-policy", action="store_true",
@@ -609,7 +650,20 @@ def format_summary(result: EvalResult) -> str:
             f"{100 * s['final_distance_mean']:.1f} cm (median "
             f"{s['final_distance_cm_median']:.1f}), heading error "
             f"{s['heading_error_deg_mean']:.1f} deg, collisions/episode "
-            f"{s['collisions_mean']:.2f}")
+            f"{s['collisions_mean']:.2f}{_route_line(s)}")
+
+
+def _route_line(s: dict[str, Any]) -> str:
+    """The route part of :func:`format_summary` ("" for a summary without routes)."""
+    if "route_episodes" not in s:
+        return ""
+    error = ("no target left" if s["target_error_mean"] is None else
+             f"target error {100 * s['target_error_mean']:.1f} cm (median "
+             f"{s['target_error_cm_median']:.1f})")
+    return (f"; route: targets reached in order {100 * s['targets_reached_fraction']:.1f}%, "
+            f"every target {100 * s['reached_rate']:.1f}% of routes, all targets within the "
+            f"radius {100 * s['all_targets_within_radius_rate']:.1f}%, targets finished "
+            f"{s['targets_finished_mean']:.1f} per route, {error}")
 
 
 if __name__ == "__main__":

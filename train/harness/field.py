@@ -33,12 +33,12 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from homing_gym.cli import command_parser  # noqa: E402
+from homing_gym.cli import command_parser, env_kwargs_from_args  # noqa: E402
 from homing_gym.geometry import wrap_angle  # noqa: E402
 from homing_gym.scenes.base import clearances  # noqa: E402
 from homing_gym.topdown import MapCanvas, draw_pose, draw_scale_bar, draw_scene  # noqa: E402
 from homing_train.harness.evaluate import (DEFAULT_ENV, add_policy_arguments,  # noqa: E402
-                                           parse_json_kwargs, policy_from_args, run_episodes)
+                                           policy_from_args, run_episodes)
 from homing_train.harness.palette import HOME_MARK  # noqa: E402
 from homing_train.harness.policies import PolicySpec, policy_spec  # noqa: E402
 from homing_train.harness.protocols import PROTOCOLS, protocol  # noqa: E402
@@ -208,28 +208,28 @@ def plot_field(result: FieldResult, path: str, size: int = 480) -> None:
 def main(argv: list[str] | None = None) -> int:
     parser = command_parser("homing-field", __doc__)
     add_policy_arguments(parser, controllers_only=True)
-    parser.add_argument("--scene", default=None, help="scene name (overrides --env-kwargs)")
     parser.add_argument("--protocol", choices=sorted(PROTOCOLS),
                         help="the field in this protocol's first setting: its env, env kwargs "
-                        "and its first episode's home")
+                        "and its first episode's home (with --seed: of that draw)")
     parser.add_argument("--grid", type=float, default=0.2, help="grid spacing (m)")
     parser.add_argument("--no-return", action="store_true",
                         help="skip the return-ratio runs (arrows only, fast)")
     parser.add_argument("--out", required=True, help="PNG path (scores go to a .json beside)")
     args = parser.parse_args(argv)
     try:
-        env_kwargs = parse_json_kwargs(args.env_kwargs)
-        env_id, seed, home = args.env, args.seed, None
+        env_kwargs = env_kwargs_from_args(args)
+        env_id, seed, home, drawn_in = args.env, args.seed or 0, None, None
         if args.protocol:
-            if args.env != DEFAULT_ENV or env_kwargs or args.scene or args.seed != 0:
+            if args.env != DEFAULT_ENV or env_kwargs:
                 raise ValueError("--protocol fixes the env, its kwargs and the home; drop "
-                                 "--env/--env-kwargs/--scene/--seed")
+                                 "--env/--env-kwargs/--scene")
             chosen = protocol(args.protocol)
+            if args.seed is not None:
+                chosen = chosen.reseeded(args.seed)
             setting = chosen.settings[0]
             env_id, env_kwargs = setting.env_id, setting.kwargs()
             seed, _, home = setting.episode_tasks(1, chosen.seed)[0]
-        if args.scene:
-            env_kwargs["scene"] = args.scene
+            drawn_in = chosen.label
         result = homing_field(policy_from_args(args), env_id, args.grid, seed,
                               env_kwargs, run_to_end=not args.no_return,
                               workers=args.workers, progress=not args.quiet, home=home)
@@ -240,6 +240,8 @@ def main(argv: list[str] | None = None) -> int:
     doc = asdict(result)
     doc["extra"] = {k: v for k, v in result.extra.items() if k != "scene"}
     doc["env_kwargs"] = env_kwargs
+    if drawn_in:
+        doc["protocol"] = drawn_in          # with the note when not its canonical draw
     with open(os.path.splitext(args.out)[0] + ".json", "w") as f:
         json.dump(doc, f)
     ratio = "n/a" if result.return_ratio is None else f"{100 * result.return_ratio:.1f}%"

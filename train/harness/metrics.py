@@ -8,6 +8,12 @@ Definitions (metres, radians unless named otherwise):
   on a route, through every target in order);
 * ``soft_spl`` = ``max(0, 1 - d_T / l) * l / max(l, p)`` (Datta et al. 2021), ``d_T`` the
   shortest-path distance from the final position to home;
+* on a route (RouteFollowing-v0; the env's ``info["target_errors"]`` holds the distance
+  at which each target was left: on reaching it, or with ``success_on="stop"`` where the
+  agent stopped), a target is *reached* when a recorded position comes within the
+  success radius of it, each target at a later position than the one before
+  (:func:`targets_reached_in_order`); the episode is *reached* when every target was,
+  in order, and *all targets within radius* when it left every target within the radius;
 * confidence intervals from ``scipy.stats``: a success rate's is the Wilson score interval
   (:func:`wilson_interval`, ``binomtest(...).proportion_ci``), a continuous metric's the
   percentile bootstrap of its mean (:func:`bootstrap_ci`, ``scipy.stats.bootstrap``, seeded);
@@ -30,7 +36,7 @@ from scipy import stats
 from homing_gym.paths import path_length
 
 __all__ = ["Aggregate", "aggregate_success", "bootstrap_ci", "distance_bins", "path_length",
-           "soft_spl", "spl", "wilson_interval"]
+           "soft_spl", "spl", "targets_reached_in_order", "wilson_interval"]
 
 
 def spl(success: bool, shortest: float, path: float) -> float:
@@ -48,6 +54,21 @@ def soft_spl(final_distance: float, shortest: float, path: float) -> float:
     if shortest <= 0:
         return 1.0 if final_distance <= 0 else 0.0
     return max(0.0, 1.0 - final_distance / shortest) * shortest / max(shortest, path)
+
+
+def targets_reached_in_order(positions, targets, radius: float) -> int:
+    """How many of the route's ``targets`` (K x 2, metres, in order) the recorded
+    ``positions`` (T x 2) reached in order: target 0 at the first position closer than
+    ``radius`` to it, target 1 at a later position, and so on (as the env moves its goal
+    on after a step), up to the first target not reached."""
+    xy = np.asarray(positions, dtype=np.float64).reshape(-1, 2)
+    t = 0
+    for k, target in enumerate(np.asarray(targets, dtype=np.float64).reshape(-1, 2)):
+        within = np.flatnonzero(np.hypot(*(xy[t:] - target).T) < radius)
+        if within.size == 0:
+            return k
+        t += int(within[0]) + 1
+    return len(targets)
 
 
 def bootstrap_ci(values, confidence: float = 0.95, n_boot: int = 2000,

@@ -17,7 +17,8 @@ Each paper protocol carries the paper's claims (:class:`Claim`): what the paper 
 one of our methods, its numbers as printed, where (section, figure, table), and how our
 setting differs from the paper's; the matrix sets them beside our cells.
 
-``homing-eval --protocol NAME --policy METHOD`` runs one method on a protocol;
+``homing-eval --protocol NAME --policy METHOD`` runs one method on a protocol (``--seed
+S``: on another draw of its episodes, recorded as not the canonical one);
 ``homing-suite --protocols ...`` runs every applicable method on each and writes the
 methods x protocols matrix. Changing what a protocol does means a new ``version``.
 """
@@ -26,7 +27,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable, Sequence
 
 import numpy as np
@@ -175,10 +176,25 @@ class Protocol:
     claims: tuple[Claim, ...] = ()     # the paper's, beside our numbers
     privileged: str = ""               # anything beyond pixels the protocol gives
     place: str = ""                    # a place rule other than the radius (the task's)
+    canonical_seed: int | None = None  # set by reseeded(): the protocol's own seed
+
+    @property
+    def canonical(self) -> bool:
+        """Whether the episodes are the protocol's own draw (not :meth:`reseeded`)."""
+        return self.canonical_seed in (None, self.seed)
+
+    def reseeded(self, seed: int) -> "Protocol":
+        """The protocol with its episodes drawn from base seed ``seed`` (``homing-eval
+        --protocol NAME --seed S``): the same settings, other scenes, homes and starts;
+        not the canonical draw unless ``seed`` is the protocol's own."""
+        own = self.seed if self.canonical_seed is None else self.canonical_seed
+        return replace(self, seed=seed, canonical_seed=own)
 
     @property
     def label(self) -> str:
-        return f"{self.name} v{self.version}"
+        name = f"{self.name} v{self.version}"
+        return name if self.canonical else (f"{name} (seed {self.seed}: not the canonical "
+                                            f"draw, seed {self.canonical_seed})")
 
     def success_radius(self, setting: Setting) -> float:
         return float(setting.env_kwargs.get("success_radius", SUCCESS_RADIUS))
@@ -186,6 +202,7 @@ class Protocol:
     def command(self, method: str, episodes: int | None = None) -> str:
         """The ``homing-eval`` command that reproduces one matrix cell."""
         extra = f" --episodes {episodes}" if episodes not in (None, self.episodes) else ""
+        extra += "" if self.canonical else f" --seed {self.seed}"
         return f"homing-eval --protocol {self.name} --policy {method}{extra} --out OUT.json"
 
 

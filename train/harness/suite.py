@@ -2,12 +2,14 @@
 
     homing-suite                       # 20 episodes of LocalHoming-v0, seed 0, into results/
     homing-suite --episodes 200 --workers 2 --out results/full
+    homing-suite --scene mesh:world.obj --env-kwargs '{"max_episode_steps": 300}'
 
-Evaluates every registered scripted controller made for the env (:func:`suite_methods`)
-and every shipped PPO policy trained on it (``train/shipped/*.zip`` with the evaluation
-settings of its ``*.yml``: ``eval_env_kwargs``, ``eval_params``, and the controllers'
-time: :func:`~homing_train.harness.matrix.equal_time_kwargs`) with the same harness
-on the same seeded episodes (episode ``i`` uses seed ``seed + i``), writes one
+Evaluates every registered scripted controller made for the env and its scene
+(:func:`suite_methods`) and every shipped PPO policy trained on the env
+(``train/shipped/*.zip`` with the evaluation settings of its ``*.yml``:
+``eval_env_kwargs``, ``eval_params``, and the controllers' time:
+:func:`~homing_train.harness.matrix.equal_time_kwargs`), every row under the same
+``--env-kwargs``/``--scene``, with the same harness on the same seeded episodes (episode ``i`` uses seed ``seed + i``), writes one
 ``<method>.json``/``.csv`` per method into ``--out``, then runs ``homing-compare`` on them:
 ``table.md`` (printed), ``success_vs_distance.png``, ``final_distance.png`` and
 ``trajectories.png``.
@@ -25,24 +27,27 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import Any
 
 import gymnasium as gym
 import homing_baselines
 import homing_gym  # noqa: F401  (registers the env ids)
-from homing_gym.cli import command_parser, seed_value
+from homing_gym.cli import add_env_arguments, command_parser, env_kwargs_from_args, seed_value
 from homing_train.extras import missing_extra
 from homing_train.harness.compare import compare
 from homing_train.harness.evaluate import (DEFAULT_ENV, add_backend_arguments, check_env_id,
                                            evaluate, format_summary)
-from homing_train.harness.matrix import equal_time_kwargs, matrix_markdown, run_matrix
+from homing_train.harness.matrix import (BASE_PERIOD, equal_time_kwargs, matrix_markdown,
+                                         run_matrix)
 from homing_train.harness.policies import shipped_policies
 from homing_train.harness.protocols import PROTOCOLS, protocol
 
-def suite_methods(env_id: str) -> list[str]:
-    """The registered controllers made for ``env_id`` in its default scene
-    (:meth:`baselines.Controller.made_for`): e.g. ``multires`` only on WorkLocations-v0,
-    the colour-identity bearing laws only where the default scene is ``lab``."""
-    env = gym.make(env_id)
+def suite_methods(env_id: str, env_kwargs: dict[str, Any] | None = None) -> list[str]:
+    """The registered controllers made for ``env_id`` in the scene that ``env_kwargs``
+    give it (default: its default scene; :meth:`baselines.Controller.made_for`): e.g.
+    ``multires`` only on WorkLocations-v0, the colour-identity bearing laws only in the
+    ``lab``. Making the env checks ``env_kwargs``."""
+    env = gym.make(env_id, **(env_kwargs or {}))
     scene = env.unwrapped.scene.name
     env.close()
     return [name for name in homing_baselines.available()
@@ -51,33 +56,48 @@ def suite_methods(env_id: str) -> list[str]:
 
 def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: int = 0,
               workers: int = 2, methods: list[str] | None = None, backend: str = "local",
-              address: str | None = None, success_on: str = "stop") -> dict[str, str]:
-    """Evaluate the methods (default: all controllers and shipped policies) and compare,
-    every row with the same success rule ``success_on`` (``"stop"``: the agent stopped
-    at the goal, the protocols' rule; ``"reach"``: came within the radius at any time)."""
+              address: str | None = None, success_on: str = "stop",
+              env_kwargs: dict[str, Any] | None = None) -> dict[str, str]:
+    """Evaluate the methods (default: all controllers and shipped policies made for the
+    env and its scene) and compare, every row with the same success rule ``success_on``
+    (``"stop"``: the agent stopped at the goal, the protocols' rule; ``"reach"``: came
+    within the radius at any time) and the same ``env_kwargs`` (e.g. the scene), a
+    learned row under them as in a protocol's setting
+    (:func:`~homing_train.harness.matrix.equal_time_kwargs`: its own input format and
+    control period, and the controllers' time)."""
     if success_on not in ("stop", "reach"):
         raise ValueError(f"unknown success rule {success_on!r}; allowed: 'stop', 'reach'")
     check_env_id(env_id)
+    env_kwargs = dict(env_kwargs or {})
+    if "success_on" in env_kwargs:
+        raise ValueError(f"env kwargs set success_on={env_kwargs['success_on']!r}; the suite's "
+                         f"one success rule is --success-on (stop or reach)")
     policies = {name: p for name, p in shipped_policies().items()
                 if p.env_id in (None, env_id)}
     if policies and (hint := missing_extra("train")):
         print(f"homing-suite: the learned rows {sorted(policies)} are left out ({hint})")
         policies = {}
-    made_for = suite_methods(env_id)
+    made_for = suite_methods(env_id, env_kwargs)
     candidates = homing_baselines.available() + sorted(policies)
     chosen = methods or made_for + sorted(policies)
     unknown = sorted(set(chosen) - set(candidates))
     if unknown:
         raise ValueError(f"unknown methods {unknown}; available: {candidates}")
+    learned = sorted(set(chosen) & set(policies))
+    if "control_period" in env_kwargs and learned:
+        raise ValueError(f"env kwargs set control_period, but the learned rows {learned} act "
+                         f"at the period they were trained with (and get the same time: "
+                         f"max_episode_steps counts steps of {BASE_PERIOD} s); drop it or "
+                         f"leave them out with --methods")
     out.mkdir(parents=True, exist_ok=True)
     paths = []
-    rule = {"success_on": success_on}        # one rule for every row, whatever it trained with
+    setting = {**env_kwargs, "success_on": success_on}   # one rule for every row
     for name in chosen:
         shipped = policies.get(name)
         policy, kwargs, params = (
             str(shipped.path),
-            equal_time_kwargs(rule, shipped.env_kwargs, gym.spec(env_id).max_episode_steps),
-            shipped.params) if shipped else (name, rule, {})
+            equal_time_kwargs(setting, shipped.env_kwargs, gym.spec(env_id).max_episode_steps),
+            shipped.params) if shipped else (name, setting, {})
         result = evaluate(policy, env_id, episodes=episodes, seed=seed, env_kwargs=kwargs,
                           workers=workers, params=params, backend=backend, address=address)
         print(format_summary(result))
@@ -93,10 +113,13 @@ def main(argv: list[str] | None = None) -> int:
                         help="run the methods x protocols matrix on these protocols ('all': "
                         f"every one of {sorted(PROTOCOLS)}) instead of the one-env suite; "
                         "--episodes then counts per setting (default: each protocol's)")
-    parser.add_argument("--env", default=DEFAULT_ENV, help="env id of the suite")
+    add_env_arguments(parser, DEFAULT_ENV)
     parser.add_argument("--episodes", type=int, default=None,
                         help="episodes per method (default 20; see --protocols)")
-    parser.add_argument("--seed", type=seed_value, default=0, help="seed of the first episode")
+    parser.add_argument("--seed", type=seed_value, default=None,
+                        help="seed of the first episode (default 0); with --protocols the "
+                        "base seed of every protocol's episode draw instead of its own (not "
+                        "the canonical draw: each cell's command then carries --seed)")
     parser.add_argument("--workers", type=int, default=2, help="parallel processes")
     parser.add_argument("--methods", nargs="+", help="subset of methods (default: all)")
     parser.add_argument("--success-on", choices=("stop", "reach"), default="stop",
@@ -113,22 +136,31 @@ def main(argv: list[str] | None = None) -> int:
     if (args.episodes is not None and args.episodes < 1) or args.workers < 1:
         parser.error("--episodes and --workers must be >= 1")
     if args.protocols:
+        if args.env != DEFAULT_ENV or args.env_kwargs or args.scene:
+            parser.error("--protocols fix the envs and their kwargs; drop "
+                         "--env/--env-kwargs/--scene")
         try:
             names = sorted(PROTOCOLS) if args.protocols == ["all"] else args.protocols
             chosen = [protocol(name) for name in names]
+            if args.seed is not None:
+                chosen = [p.reseeded(args.seed) for p in chosen]
             cells = run_matrix(chosen, Path(args.out), args.episodes, args.workers,
                                args.methods, resume=args.resume, backend=args.backend,
                                address=args.ray_address)
         except ValueError as err:
             parser.exit(2, f"homing-suite: error: {err}\n")
         print(matrix_markdown(cells))
+        for p in chosen:
+            if not p.canonical:
+                print(f"Note: {p.label}.")
         print(f"wrote {args.out}/matrix.md, matrix.csv, matrix.json, matrix.png")
         return 0
     if args.episodes is None:
         args.episodes = 20
     try:
-        written = run_suite(Path(args.out), args.env, args.episodes, args.seed, args.workers,
-                            args.methods, args.backend, args.ray_address, args.success_on)
+        written = run_suite(Path(args.out), args.env, args.episodes, args.seed or 0,
+                            args.workers, args.methods, args.backend, args.ray_address,
+                            args.success_on, env_kwargs_from_args(args))
     except ValueError as err:
         parser.exit(2, f"homing-suite: error: {err}\n")
     print(Path(written["table"]).read_text())
