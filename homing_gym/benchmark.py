@@ -18,7 +18,8 @@ corridor: every wall, door and poster textured, so most rays sample a texture), 
 and the floor, :func:`mesh_world`), ``grass10k`` and ``grass50k`` (tussock grass of
 10,000 and 50,000 thin blades the robot drives through, :func:`grass_world`). With
 ``tiny`` at 48 x 256 in the arena, homing-gym 0.1's default physics steps of 1/240 s
-(``physics_substeps=24``) are measured too.
+(``physics_substeps=24``) are measured too. ``--worlds`` also takes any scene an env
+takes: a scene name (one registered by ``--import MODULE`` too) or ``mesh:PATH``.
 
 ``--resets N`` also times ``env.reset()`` in the procedural worlds (:data:`RESET_SCENES`,
 LocalHoming-v0 with the default camera): with a new world at every reset
@@ -40,7 +41,7 @@ from tqdm import tqdm
 
 import homing_gym  # noqa: F401  (registers the envs)
 from homing_gym.cli import command_parser
-from homing_gym.scenes import Landmark, MeshScene, Scene, square_walls
+from homing_gym.scenes import Landmark, MeshScene, Scene, scene_factory, square_walls
 
 #: Panorama shapes measured, (H, W) pixels.
 SHAPES = {"48x256": (48, 256), "60x360": (60, 360), "120x720": (120, 720)}
@@ -131,18 +132,33 @@ WORLDS = {"arena": {}, "hallway": {"scene": "hallway"}, "forest10k": {"scene": f
 RESET_SCENES = ("random_arena", "random_rooms", "random_nature")
 
 
+def world_kwargs(world: str) -> dict:
+    """The env kwargs of ``world``: a benchmark world of :data:`WORLDS`, else any scene
+    an env takes (a scene name, also one registered by ``--import``, or ``mesh:PATH``);
+    ``ValueError`` naming both kinds otherwise."""
+    if world in WORLDS:
+        return WORLDS[world]
+    try:
+        scene_factory(world)
+    except ValueError as err:
+        raise ValueError(f"world {world!r}: neither a benchmark world {list(WORLDS)} nor a "
+                         f"scene ({err})") from None
+    return {"scene": world}
+
+
 def configs(renderers: list[str], shapes: list[str],
             worlds: list[str] = ("arena",)) -> dict[str, dict]:
     """Env kwargs of each measured configuration, named ``RENDERER HxW [WORLD]`` (the
-    default physics, steps of 1/120 s); with ``tiny`` at 48 x 256 in the arena also
-    ``tiny 48x256 1/240 s``, homing-gym 0.1's default env."""
+    default physics, steps of 1/120 s; ``WORLD``: :func:`world_kwargs`); with ``tiny``
+    at 48 x 256 in the arena also ``tiny 48x256 1/240 s``, homing-gym 0.1's default env."""
     out = {}
     for world in worlds:
         suffix = "" if world == "arena" else f" {world}"
+        kwargs = world_kwargs(world)
         for s in shapes:
             for r in renderers:
                 out[f"{r} {s}{suffix}"] = {"renderer": r, "panorama_shape": SHAPES[s],
-                                           **WORLDS[world]}
+                                           **kwargs}
                 if (r, s, world) == ("tiny", "48x256", "arena"):
                     out["tiny 48x256 1/240 s"] = {"renderer": r, "panorama_shape": SHAPES[s],
                                                   "physics_substeps": 24}
@@ -298,9 +314,11 @@ def main(argv: list[str] | None = None) -> int:
                         choices=["tiny", "raycast", "egl"], help="renderers to compare")
     parser.add_argument("--shapes", nargs="+", default=list(SHAPES), choices=list(SHAPES),
                         help="panorama shapes (H x W)")
-    parser.add_argument("--worlds", nargs="+", default=["arena"], choices=list(WORLDS),
-                        help="worlds (hallway: textured; forest10k: 10,290 triangles; "
-                             "mesh10k: a mesh world of 9,650 triangles)")
+    parser.add_argument("--worlds", nargs="+", default=["arena"], metavar="WORLD",
+                        help=f"benchmark worlds {list(WORLDS)} (hallway: textured; forest10k: "
+                             "10,290 triangles; mesh10k: a mesh world of 9,650 triangles) or "
+                             "any scene: a scene name (also one --import registers) or "
+                             "mesh:PATH")
     parser.add_argument("--json", help="also write the results to this JSON file")
     parser.add_argument("--resets", type=int, default=0, metavar="N",
                         help="also time N resets (x 5 blocks) in each procedural world, "
@@ -308,13 +326,16 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.steps < 10 or args.workers < 1 or args.resets < 0:
         parser.error("need --steps >= 10, --workers >= 1 and --resets >= 0")
+    try:
+        measured = configs(args.renderers, args.shapes, args.worlds)
+    except ValueError as err:
+        parser.error(f"--worlds: {err}")
     if args.json:                       # before the minutes of measuring, not after them
         try:
             open(args.json, "w").close()
         except OSError as err:
             parser.error(f"--json {args.json!r}: cannot write it ({err.strerror})")
-    results = run_configs(configs(args.renderers, args.shapes, args.worlds), args.steps,
-                          args.workers)
+    results = run_configs(measured, args.steps, args.workers)
     print(format_table(results))
     if args.resets:
         print(reset_table(args.resets))
