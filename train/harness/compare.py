@@ -57,6 +57,30 @@ def markdown_table(results: Sequence[EvalResult]) -> str:
     return "\n".join(rows) + "\n"
 
 
+def route_table(results: Sequence[EvalResult]) -> str:
+    """For the results with route episodes (RouteFollowing-v0), one row each: the share
+    of targets reached in order, of routes with every target reached in order
+    (``reached_rate``) and with every target left within the radius, targets finished
+    per route and the mean error at the targets left; "" for no such result."""
+    routes = [r for r in results if "route_episodes" in r.summary]
+    if not routes:
+        return ""
+    head = ("| method | routes | targets reached in order % [95% CI] | every target reached "
+            "% [95% CI] | all targets within radius % [95% CI] | targets finished / route "
+            "| target error (cm) |")
+    rows = [head, "|---|" + "---:|" * (head.count("|") - 2)]
+    for r in routes:
+        s = r.summary
+        error = "-" if s["target_error_mean"] is None else f"{100 * s['target_error_mean']:.1f}"
+        rows.append(
+            f"| {r.policy} | {s['route_episodes']} "
+            f"| {_ci(s, 'targets_reached_fraction', 'targets_reached_fraction_ci', 100, '.1f')} "
+            f"| {_ci(s, 'reached_rate', 'reached_ci', 100, '.1f')} "
+            f"| {_ci(s, 'all_targets_within_radius_rate', 'all_targets_within_radius_ci', 100, '.1f')} "
+            f"| {s['targets_finished_mean']:.1f} | {error} |")
+    return "\n".join(rows) + "\n"
+
+
 #: Env settings that never change an episode (what a controller reads), left out when
 #: rows are compared.
 NEUTRAL_KEYS = ("obs_keys",)
@@ -242,6 +266,8 @@ def compare(paths: Sequence[str], out: str, trajectories: int = 3) -> dict[str, 
                "final_distance": os.path.join(out, "final_distance.png")}
     with open(written["table"], "w") as f:
         f.write(markdown_table(results))
+        if routes := route_table(results):
+            f.write("\n" + routes)
         notes = settings_notes(results) + ([unpaired] if unpaired else [])
         if notes:
             f.write("\n" + "".join(f"Note: {n}.\n" for n in notes))
