@@ -1,37 +1,57 @@
 """Worlds from triangle meshes: :class:`MeshScene` from a file (OBJ, PLY, GLB/glTF, STL,
 anything ``trimesh.load`` reads) or from plain arrays, and the scene string
-``"mesh:PATH"`` that every env and command accepts in place of a scene name.
+``"mesh:PATH?key=value&key=value"`` that every env and command accepts in place of a
+scene name.
 
 The robot drives on the plane z = 0 of the (scaled, turned, shifted) mesh. Mesh triangles
 that reach into the scene's height band block it (:mod:`homing_gym.scenes.footprint`);
 the band's default, 0.02-0.35 m, leaves a mesh's own ground and anything above the robot
-(ceilings, table tops) passable. Colours come from the file: per-face or per-vertex
-colours, or a material's texture (the ray caster samples the texture through the UVs;
-TinyRenderer, which takes one colour per PyBullet mesh, shows each face in the texture's
-colour at its corners). Without ``bounds``, the free area is the footprint of the parts
-that block the robot (of all parts if none do); ``fence`` (default on) keeps the robot
-inside it even where the mesh has no walls.
+(ceilings, table tops) passable. Without ``bounds``, the free area is the footprint of the
+parts that block the robot (of all parts if none do); ``fence`` (default on) keeps the
+robot inside it even where the mesh has no walls.
 
-``"mesh:PATH"`` takes options after ``?`` as ``key=value`` pairs joined by ``&``:
-``scale`` (float), ``up`` (``z`` or ``y``), ``offset`` (``x,y,z`` metres), ``fence`` and
-``ground_plane`` (``0``/``1``), ``bounds`` (``xmin,ymin,xmax,ymax`` metres), e.g.
-``"mesh:/data/room.glb?up=y&scale=0.01"``.
+Colours come from the file: per-face or per-vertex colours, or each part's material: its
+texture through the UVs (the ray caster samples it; TinyRenderer, which takes one colour
+per PyBullet mesh, shows each face in the texture's colour at its corners), else its main
+colour (glTF ``baseColorFactor``, OBJ ``Kd``), times the vertex colours where a glTF has
+both. A texture without UVs shows as its mean colour. Alpha is ignored (all opaque).
+
+The options (:class:`MeshOptions`), as keywords of :meth:`MeshScene.from_file` or after
+``?`` in the scene string (values there are taken literally, lists comma-separated):
+
+============  =====================  ==================  ====================================
+option        scene-string value     default             meaning
+============  =====================  ==================  ====================================
+scale         ``0.0254``             1                   metres per mesh unit
+up            ``z`` or ``y``         z                   the mesh's up axis, turned onto +z
+offset        ``x,y,z``              0,0,0               metres, added after scale and turn
+bounds        ``xmin,ymin,xmax,ymax`` blocking footprint  free floor (metres), at most 100 m
+fence         ``0`` or ``1``         1                   invisible walls along the bounds
+ground_plane  ``0`` or ``1``         1                   draw a floor 2 mm below z = 0
+ground_color  ``r,g,b`` or ``r,g,b,a`` 0.55,0.55,0.55,1  the floor's colour, each in [0, 1]
+sky_color     ``r,g,b``              the env's           ray caster background, in [0, 1]
+height_band   ``low,high``           0.02,0.35           metres in which triangles block
+collision     ``0`` or ``1``         1                   whether the mesh blocks the robot
+no_collision  ``name,name``          none                parts the robot passes through
+============  =====================  ==================  ====================================
+
+e.g. ``"mesh:/data/office.glb?scale=0.0254&bounds=-10,-8,10,8&no_collision=curtain"``.
 """
 
 from __future__ import annotations
 
-import math
+import difflib
 import os
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, fields, replace
 from functools import lru_cache
-from urllib.parse import parse_qsl
 
 import numpy as np
 
 from homing_gym.scenes.base import HEIGHT_BAND, Color, Scene
 from homing_gym.scenes.footprint import band_triangles
 from homing_gym.scenes.mesh_part import MeshPart
-from homing_gym.validation import is_real
+from homing_gym.validation import is_real, require_positive
 
 UP_AXES = ("z", "y")
 #: Default colour (RGB) of faces a file gives no colour.
@@ -40,83 +60,121 @@ DEFAULT_FACE_COLOR = (0.7, 0.7, 0.7)
 BOUNDS_MARGIN = 0.05
 
 
-def _flag(value: str) -> bool:
-    if value not in ("0", "1", "true", "false"):
-        raise ValueError(f"expected 0, 1, true or false, got {value!r}")
-    return value in ("1", "true")
+def _reals(value, *shapes: tuple[int, ...]) -> np.ndarray | None:
+    """``value`` as a float array if it has one of ``shapes`` and holds only finite real
+    numbers (no strings or bools), else ``None``."""
+    try:
+        items = np.array(value, dtype=object)
+    except ValueError:          # ragged nesting
+        return None
+    if items.shape not in shapes or not all(is_real(v) for v in items.flat):
+        return None
+    return items.astype(np.float64)
 
 
-def _bounds_from_list(values: list[float]):
-    if len(values) != 4:
-        raise ValueError(f"expected xmin,ymin,xmax,ymax, got {values!r}")
-    return (values[0], values[1]), (values[2], values[3])
+@dataclass(frozen=True)
+class MeshOptions:
+    """How a mesh becomes a world (the table in :mod:`homing_gym.scenes.mesh_scene`):
+    ``scale`` metres per mesh unit, ``up`` axis, ``offset`` (x, y, z) metres, ``bounds``
+    ((xmin, ymin), (xmax, ymax)) metres or ``None`` (the blocking footprint), ``fence``,
+    ``ground_plane``, ``ground_color`` RGB(A) and ``sky_color`` RGB in [0, 1],
+    ``height_band`` (low, high) metres, ``collision``, ``no_collision`` part names.
+    Checked when made: each bad value is a ``ValueError`` naming the option."""
+
+    scale: float = 1.0
+    up: str = "z"
+    offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    bounds: tuple[tuple[float, float], tuple[float, float]] | None = None
+    fence: bool = True
+    ground_plane: bool = True
+    ground_color: Color = (0.55, 0.55, 0.55, 1.0)
+    sky_color: tuple[float, float, float] | None = None
+    height_band: tuple[float, float] = HEIGHT_BAND
+    collision: bool = True
+    no_collision: tuple[str, ...] = ()
+
+    @classmethod
+    def of(cls, options: Mapping) -> "MeshOptions":
+        """The options named in ``options``; an unknown name is a ``ValueError`` that
+        lists the allowed ones (and the closest, if it looks misspelt)."""
+        for key in options:
+            _check_option_name(key)
+        return cls(**options)
+
+    def __post_init__(self) -> None:
+        def bad(name: str, allowed: str) -> ValueError:
+            return ValueError(f"{name} must be {allowed}, got {getattr(self, name)!r}")
+
+        def put(name: str, value) -> None:
+            object.__setattr__(self, name, value)
+
+        put("scale", require_positive("scale", self.scale, "metres per mesh unit"))
+        if self.up not in UP_AXES:
+            raise bad("up", f"the mesh's up axis, one of {UP_AXES}")
+        offset = _reals(self.offset, (3,))
+        if offset is None:
+            raise bad("offset", "three finite numbers x, y, z (metres)")
+        put("offset", tuple(offset))
+        if self.bounds is not None:
+            box = _reals(self.bounds, (2, 2))
+            if box is None or not np.all(box[0] < box[1]):
+                raise bad("bounds", "((xmin, ymin), (xmax, ymax)) finite metres with "
+                                    "xmin < xmax and ymin < ymax")
+            put("bounds", tuple(map(tuple, box)))
+        for name in ("fence", "ground_plane", "collision"):
+            if not isinstance(getattr(self, name), (bool, np.bool_)):
+                raise bad(name, "True or False (0 or 1 in a scene string)")
+            put(name, bool(getattr(self, name)))
+        ground = _reals(self.ground_color, (3,), (4,))
+        if ground is None or not np.all((ground >= 0) & (ground <= 1)):
+            raise bad("ground_color", "3 or 4 numbers (RGB or RGBA) in [0, 1]")
+        put("ground_color", (*ground, 1.0)[:4])
+        if self.sky_color is not None:
+            sky = _reals(self.sky_color, (3,))
+            if sky is None or not np.all((sky >= 0) & (sky <= 1)):
+                raise bad("sky_color", "3 numbers (RGB) in [0, 1], or None")
+            put("sky_color", tuple(sky))
+        band = _reals(self.height_band, (2,))
+        if band is None or not 0 <= band[0] < band[1]:
+            raise bad("height_band", "(low, high) finite metres with 0 <= low < high")
+        put("height_band", tuple(band))
+        names = self.no_collision
+        if isinstance(names, str) or not all(isinstance(n, str) and n for n in names):
+            raise bad("no_collision", "a list of part names (non-empty strings)")
+        put("no_collision", tuple(names))
 
 
-#: ``"mesh:PATH?key=value"`` options and how to read their values.
-SPEC_OPTIONS = {
-    "scale": float,
-    "up": str,
-    "offset": lambda v: tuple(float(x) for x in v.split(",")),
-    "fence": _flag,
-    "ground_plane": _flag,
-    "bounds": lambda v: _bounds_from_list([float(x) for x in v.split(",")]),
-}
+def _check_option_name(key: str) -> None:
+    allowed = [f.name for f in fields(MeshOptions)]
+    if key not in allowed:
+        close = difflib.get_close_matches(str(key), allowed, n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise ValueError(f"unknown option {key!r}{hint}; allowed: {', '.join(allowed)}")
 
 
-def _placement(scale: float, up: str, offset) -> np.ndarray:
+def _placement(options: MeshOptions) -> np.ndarray:
     """4 x 4 transform: scale, then turn ``up`` onto +z, then shift by ``offset``."""
-    if not (is_real(scale) and scale > 0):
-        raise ValueError(f"scale must be a positive number, got {scale!r}")
-    if up not in UP_AXES:
-        raise ValueError(f"unknown up axis {up!r}; allowed: {UP_AXES}")
-    offset = tuple(offset)
-    if len(offset) != 3 or not all(math.isfinite(float(v)) for v in offset):
-        raise ValueError(f"offset must be three finite numbers (x, y, z metres), got {offset!r}")
-    turn = np.eye(4)
-    if up == "y":             # y up -> z up: (x, y, z) -> (x, -z, y)
-        turn[:3, :3] = [[1, 0, 0], [0, 0, -1], [0, 1, 0]]
-    place = np.diag([scale, scale, scale, 1.0])
-    place = turn @ place
-    place[:3, 3] = offset
+    place = np.diag([options.scale] * 3 + [1.0])
+    if options.up == "y":             # y up -> z up: (x, y, z) -> (x, -z, y)
+        place[:3, :3] = np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]]) @ place[:3, :3]
+    place[:3, 3] = options.offset
     return place
-
-
-def _transformed(part: MeshPart, transform: np.ndarray) -> MeshPart:
-    vertices = part.vertices @ transform[:3, :3].T + transform[:3, 3]
-    return MeshPart(vertices, part.faces, part.face_colors, part.uvs, part.texture,
-                    part.collision, part.name)
 
 
 @dataclass(frozen=True)
 class MeshScene(Scene):
     """A :class:`~homing_gym.scenes.base.Scene` made from triangle meshes; build one with
-    :meth:`from_file` or :meth:`from_arrays`."""
+    :meth:`from_file`, :meth:`from_arrays` or :meth:`from_parts`."""
 
     @classmethod
-    def from_parts(cls, parts: list[MeshPart], *, name: str = "mesh", scale: float = 1.0,
-                   up: str = "z", offset=(0.0, 0.0, 0.0), bounds=None, fence: bool = True,
-                   ground_plane: bool = True,
-                   ground_color: Color = (0.55, 0.55, 0.55, 1.0),
-                   sky_color: tuple[float, float, float] | None = None,
-                   height_band: tuple[float, float] = HEIGHT_BAND) -> "MeshScene":
-        """The scene of ``parts`` placed by ``scale`` (metres per mesh unit), ``up`` (the
-        mesh's up axis, ``"z"`` or ``"y"``) and ``offset`` (metres, added last);
-        ``bounds`` ((xmin, ymin), (xmax, ymax)) metres or the blocking footprint's box;
-        other arguments as in :class:`~homing_gym.scenes.base.Scene`
-        (``ground_color``: the floor's RGBA)."""
-        if not parts:
-            raise ValueError(f"mesh scene {name!r} has no mesh parts")
-        transform = _placement(scale, up, offset)
-        parts = tuple(_transformed(part, transform) for part in parts)
-        if bounds is None:
-            bounds = _footprint_bounds(parts, height_band, name)
-        return cls(name=name, bounds=tuple(tuple(float(v) for v in b) for b in bounds),
-                   meshes=parts, fence=fence, ground_plane=ground_plane,
-                   floor_color=tuple(ground_color), sky_color=sky_color,
-                   height_band=tuple(height_band))
+    def from_parts(cls, parts: list[MeshPart], *, name: str = "mesh",
+                   **options) -> "MeshScene":
+        """The scene of ``parts`` placed and set up by ``options`` (the fields of
+        :class:`MeshOptions`; a part that does not collide stays so)."""
+        return cls._build(parts, name, MeshOptions.of(options))
 
     @classmethod
-    def from_arrays(cls, vertices, faces, colors=None, *, collision: bool = True,
+    def from_arrays(cls, vertices, faces, colors=None, *, name: str = "mesh",
                     **options) -> "MeshScene":
         """One mesh of ``vertices`` ``(V, 3)`` and ``faces`` ``(F, 3)``; ``colors``: RGB
         in [0, 1] per face ``(F, 3)`` or per vertex ``(V, 3)`` (a face takes the mean of
@@ -131,33 +189,56 @@ class MeshScene(Scene):
                 face_colors = colors[faces].mean(axis=1) if per_vertex else colors
             except IndexError:
                 pass        # bad face indices: MeshPart names them
-        part = MeshPart(vertices, faces, face_colors, collision=collision,
-                        name=options.get("name", "mesh"))
-        return cls.from_parts([part], **options)
+        part = MeshPart(vertices, faces, face_colors, name=name)
+        return cls.from_parts([part], name=name, **options)
 
     @classmethod
-    def from_file(cls, path: str | os.PathLike, *, no_collision=(), collision: bool = True,
+    def from_file(cls, path: str | os.PathLike, *, name: str | None = None,
                   **options) -> "MeshScene":
         """The world in a mesh file (every geometry of a multi-part file, e.g. a glTF
-        scene, becomes one :class:`MeshPart` named after its node). ``collision``: whether
-        parts block the robot; ``no_collision``: names of parts it passes through
-        (foliage, curtains). Options as in :meth:`from_parts`; ``name`` defaults to
-        the file name. Raises ``ValueError`` naming the file when it is missing,
-        unreadable, or holds no triangles."""
-        parts = load_parts(path, collision=collision, no_collision=tuple(no_collision))
-        options.setdefault("name", os.path.basename(os.fspath(path)))
-        return cls.from_parts(parts, **options)
+        scene or an OBJ with several materials, becomes one :class:`MeshPart` named
+        after its node or material). ``name`` defaults to the file name; ``options`` as
+        in :meth:`from_parts`, checked before the file is read. Raises ``ValueError``
+        naming the file when it is missing, a directory, unreadable, or holds no
+        triangles, and naming the part when its colours do not fit its vertices."""
+        checked = MeshOptions.of(options)
+        return cls._build(load_parts(path), name or os.path.basename(os.fspath(path)),
+                          checked)
+
+    @classmethod
+    def _build(cls, parts: list[MeshPart], name: str, options: MeshOptions) -> "MeshScene":
+        if not parts:
+            raise ValueError(f"mesh scene {name!r} has no mesh parts")
+        unknown = sorted(set(options.no_collision) - {p.name for p in parts})
+        if unknown:
+            raise ValueError(f"no_collision names {unknown} are not parts of {name!r}; its "
+                             f"parts: {sorted({p.name for p in parts})}")
+        transform = _placement(options)
+        parts = tuple(replace(
+            part, vertices=part.vertices @ transform[:3, :3].T + transform[:3, 3],
+            collision=(part.collision and options.collision
+                       and part.name not in options.no_collision)) for part in parts)
+        bounds = options.bounds or _footprint_bounds(parts, options.height_band, name)
+        return cls(name=name, bounds=bounds, meshes=parts, fence=options.fence,
+                   ground_plane=options.ground_plane, floor_color=options.ground_color,
+                   sky_color=options.sky_color, height_band=options.height_band)
 
 
-def load_parts(path, *, collision: bool = True,
-               no_collision: tuple[str, ...] = ()) -> list[MeshPart]:
-    """The :class:`MeshPart` of each geometry in the file at ``path`` (see
+def _mesh_file(path: str) -> None:
+    """``ValueError`` unless ``path`` is a file."""
+    if os.path.isdir(path):
+        raise ValueError(f"mesh file {path!r} is a directory, not a mesh file")
+    if not os.path.isfile(path):
+        raise ValueError(f"mesh file {path!r} does not exist")
+
+
+def load_parts(path: str | os.PathLike) -> list[MeshPart]:
+    """The :class:`MeshPart` of each geometry in the file at ``path``, all colliding (see
     :meth:`MeshScene.from_file`)."""
     import trimesh      # imported here: only mesh worlds need its loaders
 
     path = os.fspath(path)
-    if not os.path.isfile(path):
-        raise ValueError(f"mesh file {path!r} does not exist")
+    _mesh_file(path)
     try:
         loaded = trimesh.load(path, process=False)
     except Exception as error:   # trimesh raises many kinds for a broken file
@@ -168,39 +249,81 @@ def load_parts(path, *, collision: bool = True,
     if not meshes:
         raise ValueError(f"mesh file {path!r} has no triangles (empty, or only points "
                          f"or lines)")
-    names = [str(m.metadata.get("name") or m.metadata.get("node")
-                 or os.path.basename(path)) for m in meshes]
-    unknown = sorted(set(no_collision) - set(names))
-    if unknown:
-        raise ValueError(f"no_collision names {unknown} are not parts of {path!r}; its "
-                         f"parts: {sorted(set(names))}")
     try:
-        return [_part(m, name, collision and name not in no_collision)
-                for m, name in zip(meshes, names)]
+        return [_part(m, str(m.metadata.get("name") or m.metadata.get("node")
+                             or os.path.basename(path))) for m in meshes]
     except ValueError as error:
         raise ValueError(f"mesh file {path!r}: {error}") from None
 
 
-def _part(mesh, name: str, collision: bool) -> MeshPart:
+def _part(mesh, name: str) -> MeshPart:
     """A trimesh mesh as a :class:`MeshPart`, with its colours or texture."""
-    visual = mesh.visual
+    part = MeshPart(np.asarray(mesh.vertices, np.float64), np.asarray(mesh.faces),
+                    np.tile(DEFAULT_FACE_COLOR, (len(mesh.faces), 1)), name=name)
+    visual, count = mesh.visual, len(part.vertices)
     uvs = texture = None
-    if visual.kind == "texture":
-        image = getattr(visual.material, "image", None) or getattr(
-            visual.material, "baseColorTexture", None)
-        if image is not None and visual.uv is not None and len(visual.uv) == len(mesh.vertices):
-            uvs = np.asarray(visual.uv, np.float64)
-            texture = np.asarray(image.convert("RGB"), np.uint8)
-    if visual.kind is None:
-        face_colors = np.tile(DEFAULT_FACE_COLOR, (len(mesh.faces), 1))
-    else:
-        from trimesh.visual.color import vertex_to_face_color
+    try:
+        if visual.kind == "face":
+            face_colors = _rgb(visual.face_colors, len(part.faces), "face") / 255
+        elif visual.kind in ("vertex", "texture"):
+            if visual.kind == "vertex":
+                colors = _rgb(visual.vertex_colors, count, "vertex")
+            else:
+                colors, uvs, texture = _material_colors(visual, count)
+            face_colors = colors[part.faces].mean(axis=1) / 255
+        else:
+            return part
+    except ValueError as error:
+        raise ValueError(f"mesh part {name!r}: {error}") from None
+    return replace(part, face_colors=face_colors, uvs=uvs, texture=texture)
 
-        rgba = (vertex_to_face_color(visual.to_color().vertex_colors, mesh.faces)
-                if visual.kind == "texture" else visual.face_colors)
-        face_colors = np.asarray(rgba, np.float64)[:, :3] / 255.0
-    return MeshPart(np.asarray(mesh.vertices, np.float64), np.asarray(mesh.faces), face_colors,
-                    uvs, texture, collision, name)
+
+def _rgb(colors, count: int, what: str) -> np.ndarray:
+    """Colours as trimesh gives them (one, or one per item; RGB or RGBA; 0-255 or 0-1)
+    as ``(count, 3)`` RGB in [0, 255] (so that equal corners average exactly)."""
+    from trimesh.visual.color import to_rgba
+
+    rgba = np.asarray(to_rgba(colors), np.float64).reshape(-1, 4)
+    if len(rgba) == 1:
+        rgba = np.repeat(rgba, count, axis=0)
+    if len(rgba) != count:
+        raise ValueError(f"{len(rgba)} {what} colours, expected 1 or {count}")
+    return rgba[:, :3]
+
+
+def _material_colors(visual, count: int):
+    """Per-vertex RGB in [0, 255] of a trimesh ``TextureVisuals``: its texture at each
+    vertex's UV (its mean colour without UVs), or without a texture its material's colour
+    (glTF ``baseColorFactor``, white if none; OBJ ``Kd``), times its vertex colours where
+    it has them; and the UVs and texture for the ray caster (``None`` without both)."""
+    from trimesh.visual.color import uv_to_color
+    from trimesh.visual.material import PBRMaterial, SimpleMaterial
+
+    material = visual.material
+    if isinstance(material, PBRMaterial):
+        image, color = material.baseColorTexture, material.baseColorFactor
+    elif isinstance(material, SimpleMaterial):
+        image, color = material.image, material.diffuse
+    else:
+        raise ValueError(f"material of type {type(material).__name__} is not supported; "
+                         f"allowed: SimpleMaterial (OBJ), PBRMaterial (glTF)")
+    uvs = texture = None
+    if image is None:
+        colors = _rgb((255, 255, 255) if color is None else color, count, "material")
+    else:
+        texture = np.asarray(image.convert("RGB"), np.uint8)
+        if visual.uv is None:
+            colors = _rgb(texture.reshape(-1, 3).mean(axis=0) / 255, count, "texture")
+            texture = None
+        else:
+            uvs = np.asarray(visual.uv, np.float64)
+            if uvs.shape != (count, 2) or not np.all(np.isfinite(uvs)):
+                raise ValueError(f"texture coordinates must be finite, one (u, v) per "
+                                 f"vertex: got shape {uvs.shape} for {count} vertices")
+            colors = _rgb(uv_to_color(uvs, image), count, "texture")
+    if "color" in visual.vertex_attributes:
+        colors = colors * _rgb(visual.vertex_attributes["color"], count, "vertex") / 255
+    return colors, uvs, texture
 
 
 def _footprint_bounds(parts: tuple[MeshPart, ...], band, name: str):
@@ -221,35 +344,94 @@ def _footprint_bounds(parts: tuple[MeshPart, ...], band, name: str):
     return (float(low[0]), float(low[1])), (float(high[0]), float(high[1]))
 
 
-def parse_mesh_spec(spec: str) -> tuple[str, dict]:
-    """``"mesh:PATH?key=value&..."`` -> (path, options for :meth:`MeshScene.from_file`)."""
-    body = spec[len("mesh:"):]
-    path, _, query = body.partition("?")
+def _flag(text: str) -> bool:
+    if text not in ("0", "1", "true", "false"):
+        raise ValueError("expected 0, 1, true or false")
+    return text in ("1", "true")
+
+
+def _floats(*counts: int) -> Callable[[str], tuple[float, ...]]:
+    """A reader of ``counts`` (one of them) comma-separated numbers."""
+    def read(text: str) -> tuple[float, ...]:
+        try:
+            values = tuple(float(v) for v in text.split(","))
+        except ValueError:
+            values = ()
+        if len(values) not in counts:
+            raise ValueError(f"expected {' or '.join(map(str, counts))} comma-separated "
+                             f"number{'s' if max(counts) > 1 else ''}")
+        return values
+    return read
+
+
+def _bounds(text: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    values = _floats(4)(text)
+    return values[:2], values[2:]
+
+
+def _names(text: str) -> tuple[str, ...]:
+    names = tuple(text.split(","))
+    if not all(names):
+        raise ValueError("expected comma-separated part names, none empty")
+    return names
+
+
+#: How the text of each ``"mesh:PATH?key=value"`` option becomes a
+#: :class:`MeshOptions` value (which then checks it).
+SPEC_OPTIONS: dict[str, Callable[[str], object]] = {
+    "scale": lambda text: _floats(1)(text)[0],
+    "up": str,
+    "offset": _floats(3),
+    "bounds": _bounds,
+    "fence": _flag,
+    "ground_plane": _flag,
+    "ground_color": _floats(3, 4),
+    "sky_color": _floats(3),
+    "height_band": _floats(2),
+    "collision": _flag,
+    "no_collision": _names,
+}
+
+
+def parse_mesh_spec(spec: str) -> tuple[str, MeshOptions]:
+    """``"mesh:PATH?key=value&..."`` -> (path, its :class:`MeshOptions`); a bad, unknown,
+    repeated or empty option is a ``ValueError`` naming it and what is allowed."""
+    path, _, query = spec[len("mesh:"):].partition("?")
     if not path:
         raise ValueError(f"scene {spec!r}: give a file after 'mesh:', e.g. 'mesh:world.obj'")
-    options = {}
-    for key, value in parse_qsl(query, keep_blank_values=True, strict_parsing=bool(query)):
-        if key not in SPEC_OPTIONS:
-            raise ValueError(f"scene {spec!r}: unknown option {key!r}; allowed: "
-                             f"{sorted(SPEC_OPTIONS)}")
-        try:
-            options[key] = SPEC_OPTIONS[key](value)
-        except ValueError as error:
-            raise ValueError(f"scene {spec!r}: bad {key}={value!r}: {error}") from None
-    return path, options
+    options: dict[str, object] = {}
+    try:
+        for field in query.split("&") if query else ():
+            key, equals, text = field.partition("=")
+            if not key:
+                raise ValueError(f"empty option {field!r}: write options as "
+                                 f"mesh:PATH?key=value&key=value")
+            _check_option_name(key)
+            if not equals:
+                raise ValueError(f"option {key!r} has no value: write {key}=VALUE")
+            if key in options:
+                raise ValueError(f"option {key!r} is given twice; give each option once")
+            try:
+                options[key] = SPEC_OPTIONS[key](text)
+            except ValueError as error:
+                raise ValueError(f"bad {key}={text!r}: {error}") from None
+        return path, MeshOptions(**options)
+    except ValueError as error:
+        raise ValueError(f"scene {spec!r}: {error}") from None
 
 
 def mesh_scene_from_spec(spec: str) -> MeshScene:
     """The :class:`MeshScene` named by a ``"mesh:PATH?..."`` string; a file is read once
     per process while it is unchanged."""
     path, options = parse_mesh_spec(spec)
-    if not os.path.isfile(path):
-        raise ValueError(f"scene {spec!r}: mesh file {path!r} does not exist")
+    try:
+        _mesh_file(path)
+    except ValueError as error:
+        raise ValueError(f"scene {spec!r}: {error}") from None
     stat = os.stat(path)
-    return _cached_scene(os.path.abspath(path), stat.st_mtime_ns, stat.st_size,
-                         tuple(sorted(options.items())))
+    return _cached_scene(os.path.abspath(path), stat.st_mtime_ns, stat.st_size, options)
 
 
 @lru_cache(maxsize=8)
-def _cached_scene(path: str, mtime: int, size: int, options: tuple) -> MeshScene:
-    return MeshScene.from_file(path, **dict(options))
+def _cached_scene(path: str, mtime: int, size: int, options: MeshOptions) -> MeshScene:
+    return MeshScene.from_file(path, **vars(options))
