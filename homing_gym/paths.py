@@ -7,6 +7,13 @@ metres; Dijkstra from ``scipy.sparse.csgraph``) shortened by line-of-sight strin
 and then tightened like a taut string (any-angle; a few millimetres longer than the true
 shortest path). Obstacles are what :func:`homing_gym.scenes.base.clearance` sees:
 walls, landmarks and the scene bounds.
+
+``connected(scene, a, b, radius)`` says, without searching, whether ``shortest_path``
+finds a path: the free regions of the grid are labelled once per scene
+(:func:`regions`, ``scipy.ndimage.label``). Tasks draw every episode's start and goals
+joined in this sense at their ``path_radius``, on the grid of :data:`RESOLUTION`, which
+is the one the oracle plans on and SPL measures on: a drawn episode always has the path
+they use.
 """
 
 from __future__ import annotations
@@ -14,14 +21,26 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy import ndimage
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
+from homing_gym.robot import RobotConfig
 from homing_gym.scenes.base import Scene, clearances, per_scene
 
-# the four forward steps (dx >= 0) of the 8-connected grid and their lengths (cells)
 #: Floor points whose clearances are computed at once (bounds the memory of big worlds).
 CHUNK = 1 << 16
+#: The robot's body radius (m): the least clearance of any floor point it stands on.
+BODY_RADIUS = RobotConfig.body_radius
+#: Grid spacing (m) on which episodes are drawn joined, the oracle plans and SPL measures.
+RESOLUTION = 0.05
+#: A floor point joins the grid through every node within this distance (m) in x and in
+#: y, free or not (a robot pushed towards an obstacle may still leave).
+ATTACH = 0.06
+#: Longest leg (m) of the string pulled taut round obstacles (round a disc of 0.27 m its
+#: length comes within 0.3% of the true shortest path's).
+TAUT_STEP = 0.08
+# the four forward steps (dx >= 0) of the 8-connected grid and their lengths (cells)
 _STEPS = ((1, 0, 1.0), (0, 1, 1.0), (1, 1, math.sqrt(2.0)), (1, -1, math.sqrt(2.0)))
 
 
@@ -44,6 +63,31 @@ def occupancy(scene: Scene, radius: float, resolution: float) -> tuple[np.ndarra
     return free.reshape(nx, ny), (xmin, ymin)
 
 
+@per_scene
+def regions(scene: Scene, radius: float, resolution: float) -> np.ndarray:
+    """The free regions of :func:`occupancy` joined by the grid search's 8-connected moves:
+    integer grid of the same shape, 0 where blocked, else the region's label (1, 2, ...).
+    Cached per scene."""
+    free, _ = occupancy(scene, radius, resolution)
+    return ndimage.label(free, structure=np.ones((3, 3), bool))[0]
+
+
+def connected(scene: Scene, a, b, radius: float = BODY_RADIUS,
+              resolution: float = RESOLUTION) -> bool:
+    """Whether :func:`shortest_path` with the same arguments finds a path from floor point
+    ``a`` to ``b`` (metres), decided without searching it: the straight segment is free,
+    or the grid nodes that ``a`` and ``b`` join (:data:`ATTACH`) touch one free region
+    (:func:`regions`), or touch each other."""
+    if segment_free(scene, a, b, radius):
+        return True
+    labels = regions(scene, radius, resolution)
+    ends, k = _ends(scene, a, b, radius, resolution), _attach_cells(resolution)
+    if max(abs(ends[0][0] - ends[1][0]), abs(ends[0][1] - ends[1][1])) <= 2 * k + 1:
+        return True
+    near = [labels[_block(c, k + 1)] for c in ends]   # the attached nodes and their neighbours
+    return bool(np.intersect1d(near[0][near[0] > 0], near[1][near[1] > 0]).size)
+
+
 def segment_free(scene: Scene, a, b, radius: float, step: float = 0.01) -> bool:
     """Whether a disc of ``radius`` can slide from ``a`` to ``b`` (checked every ``step`` m;
     extra coordinates such as a yaw are ignored)."""
@@ -62,36 +106,50 @@ def path_length(points) -> float:
     return float(np.sum(np.hypot(*np.diff(pts[:, :2], axis=0).T)))
 
 
-def shortest_path(scene: Scene, start, goal, radius: float = 0.16,
-                  resolution: float = 0.02) -> list[tuple[float, float]]:
+def shortest_path(scene: Scene, start, goal, radius: float = BODY_RADIUS,
+                  resolution: float = RESOLUTION) -> list[tuple[float, float]]:
     """Waypoints ``[start, ..., goal]`` (metres) of a short free path; see the module doc.
 
-    Raises :class:`NoPathError` when the grid search finds no connection.
+    Raises :class:`NoPathError` when the grid search finds no connection (exactly when
+    :func:`connected` is false).
     """
     a, b = (float(start[0]), float(start[1])), (float(goal[0]), float(goal[1]))
     if segment_free(scene, a, b, radius):
         return [a, b]
     free, (x0, y0) = occupancy(scene, radius, resolution)
-    nx, ny = free.shape
-
-    def cell(p) -> tuple[int, int]:
-        return (min(nx - 1, max(0, int(round((p[0] - x0) / resolution)))),
-                min(ny - 1, max(0, int(round((p[1] - y0) / resolution)))))
 
     def centre(c) -> tuple[float, float]:
         return x0 + c[0] * resolution, y0 + c[1] * resolution
 
-    src, dst = cell(a), cell(b)
-    free = free.copy()  # a robot pushed near an obstacle may still leave: free its surroundings
+    src, dst = _ends(scene, a, b, radius, resolution)
+    free = free.copy()
     for c in (src, dst):
-        free[max(0, c[0] - 3):c[0] + 4, max(0, c[1] - 3):c[1] + 4] = True
+        free[_block(c, _attach_cells(resolution))] = True
     cells = _grid_path(free, src, dst)
     if cells is None:
         raise NoPathError(f"no free path for radius {radius} m from {a} to {b} "
                           f"in scene {scene.name!r}")
     points = [a] + [centre(c) for c in cells[1:-1]] + [b]
     visible = lambda p, q: segment_free(scene, p, q, radius)  # noqa: E731
-    return _tighten(_subdivide(_string_pull(points, visible), 4 * resolution), visible)
+    return _tighten(_subdivide(_string_pull(points, visible), TAUT_STEP), visible)
+
+
+def _ends(scene: Scene, a, b, radius: float, resolution: float) -> list[tuple[int, int]]:
+    """The grid nodes nearest to floor points ``a`` and ``b``."""
+    free, (x0, y0) = occupancy(scene, radius, resolution)
+    nx, ny = free.shape
+    return [(min(nx - 1, max(0, int(round((p[0] - x0) / resolution)))),
+             min(ny - 1, max(0, int(round((p[1] - y0) / resolution))))) for p in (a, b)]
+
+
+def _attach_cells(resolution: float) -> int:
+    """:data:`ATTACH` in grid steps (at least one)."""
+    return max(1, int(round(ATTACH / resolution)))
+
+
+def _block(cell: tuple[int, int], k: int) -> tuple[slice, slice]:
+    """The nodes within ``k`` steps of ``cell`` in x and in y."""
+    return slice(max(0, cell[0] - k), cell[0] + k + 1), slice(max(0, cell[1] - k), cell[1] + k + 1)
 
 
 def _grid_path(free: np.ndarray, src, dst) -> list | None:

@@ -15,6 +15,7 @@ from typing import ClassVar
 import numpy as np
 
 from homing_gym.observations import ObservationKey
+from homing_gym.paths import BODY_RADIUS, RESOLUTION, occupancy
 from homing_gym.scenes.base import Scene, clearance
 from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.episode import Episode
@@ -29,6 +30,15 @@ class Task(ABC):
     #: The task commands the robot itself in some phase (unicycle commands from
     #: :meth:`command`), so the synchro drive is not available with it.
     drives_robot: ClassVar[bool] = False
+    #: Clearance (m) that the task's starts and goals keep from walls and objects.
+    clearance_margin: float = BODY_RADIUS
+
+    @property
+    def path_radius(self) -> float:
+        """Radius (m) of the disc for which every episode's start and goals, in order, are
+        joined by paths (:func:`homing_gym.paths.connected`): the oracle plans and SPL
+        measures shortest paths at it. Default: ``clearance_margin``."""
+        return self.clearance_margin
 
     @abstractmethod
     def sample_episode(self, scene: Scene, rng: np.random.Generator) -> Episode:
@@ -75,13 +85,30 @@ def check_start_jitter(scene: Scene, point, jitter: float, margin: float, what: 
                          f"at most {fits:.3f} m fits")
 
 
+#: Draws over the scene bounds before :func:`sample_free_pose` draws over free cells.
+BOUNDS_TRIES = 100
+
+
 def sample_free_pose(scene: Scene, rng: np.random.Generator, margin: float,
                      max_tries: int = 1000) -> np.ndarray:
-    """A uniformly drawn pose whose floor point has at least ``margin`` metres of clearance."""
+    """A pose (x, y, yaw; metres, radians) uniform over the floor points with at least
+    ``margin`` metres of clearance: drawn over the scene bounds until one is clear, as
+    earlier versions drew it (a seed keeps its episodes), for up to :data:`BOUNDS_TRIES`
+    draws; then over the free cells of the grid (:func:`homing_gym.paths.occupancy` at
+    ``margin`` and :data:`~homing_gym.paths.RESOLUTION`), so that a mostly blocked world
+    costs no more than an open one. ``ValueError`` when no point is that clear."""
     (xmin, ymin), (xmax, ymax) = scene.bounds
-    for _ in range(max_tries):
+    for _ in range(BOUNDS_TRIES):
         xy = (float(rng.uniform(xmin, xmax)), float(rng.uniform(ymin, ymax)))
         if clearance(scene, xy) >= margin:
             return np.array([xy[0], xy[1], float(rng.uniform(-np.pi, np.pi))])
-    raise RuntimeError(f"scene {scene.name!r}: no pose with {margin} m clearance found in "
-                       f"{max_tries} tries")
+    free, (x0, y0) = occupancy(scene, margin, RESOLUTION)
+    cells = np.argwhere(free)
+    for _ in range(max_tries if len(cells) else 0):
+        (i, j), (dx, dy) = cells[rng.integers(len(cells))], rng.uniform(-0.5, 0.5, 2)
+        xy = (float(x0 + (i + dx) * RESOLUTION), float(y0 + (j + dy) * RESOLUTION))
+        if clearance(scene, xy) >= margin:
+            return np.array([xy[0], xy[1], float(rng.uniform(-np.pi, np.pi))])
+    raise ValueError(f"scene {scene.name!r} has no floor point with {margin} m of clearance "
+                     f"(none found among {len(cells)} free grid cells of "
+                     f"{RESOLUTION} m)")

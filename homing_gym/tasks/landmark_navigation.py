@@ -5,7 +5,9 @@ The scene must list its landmark panels in ``scene.metadata["landmarks"]`` as
 ``{id: (x, y, normal)}`` (the centre of the panel's face on the wall, metres, and the
 wall normal into the room, radians), and the free rectangles of its floor plan in
 ``metadata["rooms"]`` (like the ``corridors`` scene). Each episode draws the goal id
-among the panels present and a start pose anywhere in the rooms.
+among the panels present and a start pose anywhere in the rooms, ``clearance_margin``
+metres clear and joined to the goal's standing pose by a path for a disc of that
+radius (:func:`homing_gym.paths.connected`).
 
 *In front of* landmark ``g`` (the success test): the robot centre is at most
 ``max_distance`` metres from the panel centre (horizontally), within ``max_angle`` of
@@ -25,6 +27,7 @@ from gymnasium import spaces
 
 from homing_gym.geometry import bearing_to, wrap_angle
 from homing_gym.observations import ObservationKey, constant_key
+from homing_gym.paths import connected
 from homing_gym.perspective import PerspectiveConfig
 from homing_gym.scenes.base import Scene, clearance
 from homing_gym.selfsimilar import MAX_ID
@@ -100,10 +103,14 @@ class LandmarkNavigationTask(Task):
             (x0, y0), (x1, y1) = rooms[rng.choice(len(rooms), p=areas / areas.sum())]
             xy = (float(rng.uniform(x0, x1)), float(rng.uniform(y0, y1)))
             start = np.array([*xy, float(rng.uniform(-math.pi, math.pi))])
-            if clearance(scene, xy) >= self.clearance_margin and not self.in_front(
-                    scene, start, self.goal_id):
+            if (clearance(scene, xy) >= self.clearance_margin
+                    and not self.in_front(scene, start, self.goal_id)
+                    and connected(scene, xy, home, self.clearance_margin)):
                 return Episode(home=home, start=start)
-        raise RuntimeError(f"scene {scene.name!r}: no free start pose found")
+        raise ValueError(f"scene {scene.name!r}: no start pose in its rooms with "
+                         f"{self.clearance_margin} m of clearance from which a disc of that "
+                         f"radius can reach the standing pose of landmark {self.goal_id} "
+                         f"({home[0]:.2f}, {home[1]:.2f}) (1000 tries)")
 
     def in_front(self, scene: Scene, pose, landmark_id: int) -> bool:
         """Whether ``pose`` stands in front of landmark ``landmark_id`` (module docstring)."""

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from homing_gym.paths import connected
 from homing_gym.scenes.base import Scene, clearance
 from homing_gym.tasks.base import Episode, sample_free_pose
 from homing_gym.tasks.goal_reaching import GoalReachingTask, RewardConfig
@@ -13,9 +14,10 @@ from homing_gym.validation import require_positive
 
 
 class LocalHomingTask(GoalReachingTask):
-    """Start within ``start_distance`` metres of a random collision-free home pose; the
-    only goal is home (see :class:`GoalReachingTask` for ``success_radius`` and
-    ``success_on``)."""
+    """Start within ``start_distance`` metres of a random collision-free home pose, both
+    ``clearance_margin`` metres clear of walls and objects and joined by a path for a
+    disc of that radius (:func:`homing_gym.paths.connected`); the only goal is home (see
+    :class:`GoalReachingTask` for ``success_radius`` and ``success_on``)."""
 
     def __init__(self, start_distance: tuple[float, float] = (0.3, 1.5),
                  success_radius: float = 0.15, success_on: str = "reach",
@@ -54,14 +56,21 @@ class LocalHomingTask(GoalReachingTask):
 
     def sample_episode(self, scene: Scene, rng: np.random.Generator,
                        max_tries: int = 200) -> Episode:
+        """A home (:func:`sample_free_pose`), then up to 20 starts at a uniform distance
+        in ``start_distance`` and direction around it, until one is clear and joined to
+        home; up to ``max_tries`` homes, then ``ValueError``."""
+        margin = self.clearance_margin
         for _ in range(max_tries):
-            home = sample_free_pose(scene, rng, self.clearance_margin)
+            home = sample_free_pose(scene, rng, margin)
             for _ in range(20):
                 d = rng.uniform(*self.start_distance)
                 a = rng.uniform(-np.pi, np.pi)
                 xy = (home[0] + d * math.cos(a), home[1] + d * math.sin(a))
-                if clearance(scene, xy) >= self.clearance_margin:
+                if clearance(scene, xy) >= margin and connected(scene, home, xy, margin):
                     start = np.array([xy[0], xy[1], rng.uniform(-np.pi, np.pi)])
                     return Episode(home=home, start=start)
-        raise ValueError(f"start_distance {self.start_distance} m does not fit into scene "
-                         f"{scene.name!r} of size {scene.size} m")
+        raise ValueError(f"scene {scene.name!r} of size {scene.size} m holds no home and start "
+                         f"{self.start_distance[0]}-{self.start_distance[1]} m apart with "
+                         f"{margin} m of clearance that a disc of {margin} m radius can travel "
+                         f"between (tried {max_tries} homes); use a smaller start_distance "
+                         f"or a more open scene")

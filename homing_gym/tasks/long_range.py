@@ -19,8 +19,9 @@ from gymnasium import spaces
 
 from homing_gym.geometry import bearing_to
 from homing_gym.observations import ObservationKey, constant_key
+from homing_gym.paths import segment_free
 from homing_gym.robot import RobotConfig
-from homing_gym.scenes.base import Scene, clearance
+from homing_gym.scenes.base import Scene
 from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.base import Episode, sample_free_pose
 from homing_gym.tasks.goal_reaching import GoalReachingTask, RewardConfig
@@ -34,20 +35,14 @@ WAYPOINT_RADIUS = 0.05
 TURN_FIRST = 0.2
 
 
-def segment_is_free(scene: Scene, a, b, margin: float, spacing: float = 0.05) -> bool:
-    """Whether every point of segment ``a``-``b`` (m) has ``margin`` m of clearance."""
-    n = max(2, math.ceil(math.dist(a, b) / spacing) + 1)
-    return all(clearance(scene, (a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])))
-               >= margin for t in np.linspace(0.0, 1.0, n))
-
-
 def plan_route(scene: Scene, start, rng: np.random.Generator, length: float,
                margin: float, legs: tuple[float, float] = (0.8, 2.0),
                max_restarts: int = 200) -> np.ndarray:
     """A collision-free polyline ``(K, 2)`` (m) from ``start`` of total length ``length``:
     legs of uniform length in ``legs``, each turning by up to 120 degrees from the last
-    (any direction for the first), every point ``margin`` m clear of walls and objects.
-    ``ValueError`` if the scene cannot hold such a route."""
+    (any direction for the first), every point ``margin`` m clear of walls and objects
+    (checked every 5 cm), so that the route's end is joined to its start by a path for a
+    disc of radius ``margin``. ``ValueError`` if the scene cannot hold such a route."""
     for _ in range(max_restarts):
         points = [np.asarray(start[:2], dtype=np.float64)]
         heading = float(rng.uniform(-math.pi, math.pi))
@@ -59,7 +54,7 @@ def plan_route(scene: Scene, start, rng: np.random.Generator, length: float,
                     else rng.uniform(-2 * math.pi / 3, 2 * math.pi / 3)
                 h = heading + float(turn)
                 end = points[-1] + leg * np.array([math.cos(h), math.sin(h)])
-                if segment_is_free(scene, points[-1], end, margin):
+                if segment_free(scene, points[-1], end, margin, step=0.05):
                     points.append(end)
                     heading, total = h, total + leg
                     break

@@ -12,6 +12,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from homing_gym.geometry import FOOT, wrap_angle
+from homing_gym.paths import BODY_RADIUS, connected
 from homing_gym.scenes.base import Scene, clearance
 from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.base import Episode, check_start_jitter
@@ -73,10 +74,12 @@ class RouteFollowingTask(GoalReachingTask):
     (x, y) or (x, y, yaw), see :func:`route_poses`) the robot starts at its first point and
     the other points are the targets, in order; ``n_targets`` and ``spacing`` must then
     keep their defaults. The start is perturbed by up to ``start_jitter = (metres,
-    radians)`` (uniform in x, y and yaw). Every point needs ``clearance_margin`` metres of
-    clearance in the scene. A target counts as reached within ``success_radius`` (default
-    0.1 m, a third of the spacing), or, with ``success_on="stop"``, when the agent stops;
-    then the next target's snapshot becomes the goal."""
+    radians)`` (uniform in x, y and yaw). Every point of the straight route needs
+    ``clearance_margin`` metres of clearance, every point of a given route room for the
+    robot's body; each point must be joined to the next by a path for a disc of that
+    radius (:meth:`check_scene`). A target counts as reached within ``success_radius``
+    (default 0.1 m, a third of the spacing), or, with ``success_on="stop"``, when the
+    agent stops; then the next target's snapshot becomes the goal."""
 
     def __init__(self, n_targets: int = N_TARGETS, spacing: float = SPACING,
                  start_jitter: tuple[float, float] = (0.05, math.radians(10)),
@@ -109,36 +112,49 @@ class RouteFollowingTask(GoalReachingTask):
         return [np.array([x0 + k * self.spacing * c, y0 + k * self.spacing * s, yaw])
                 for k in range(-1, self.n_targets)]
 
+    @property
+    def path_radius(self) -> float:
+        """A given route needs room for the robot's body only (:data:`BODY_RADIUS`
+        metres); the straight route ``clearance_margin``."""
+        return BODY_RADIUS if self.route is not None else self.clearance_margin
+
     def check_scene(self, scene: Scene) -> None:
-        if self.route is not None:
-            for k, pose in enumerate(self.route):
-                self._check_route_point(scene, k, pose)
-        elif "route_origin" not in scene.metadata:
+        """``ValueError`` unless every point of the route is clear (:attr:`path_radius`
+        metres) and each is joined to the next by a path for a disc of that radius
+        (:func:`homing_gym.paths.connected`), and every start of the jitter is clear."""
+        if self.route is None and "route_origin" not in scene.metadata:
             raise ValueError(f"scene {scene.name!r} defines no route (metadata['route_origin']); "
                              f"use a scene with one, e.g. 'hallway', or give route=[...]")
-        else:
-            for pose in self._route(scene):
-                if clearance(scene, (pose[0], pose[1])) < self.clearance_margin:
-                    raise ValueError(
-                        f"{self.n_targets} targets {self.spacing} m apart do not fit along "
-                        f"the route of scene {scene.name!r}: ({pose[0]:.2f}, {pose[1]:.2f}) "
-                        f"is blocked")
-        check_start_jitter(scene, self._route(scene)[0], self.start_jitter[0],
-                           self.clearance_margin, "the route's start")
+        points, radius = self._route(scene), self.path_radius
+        for k, pose in enumerate(points):
+            if self.route is not None:
+                self._check_route_point(scene, k, pose)
+            elif clearance(scene, (pose[0], pose[1])) < radius:
+                raise ValueError(
+                    f"{self.n_targets} targets {self.spacing} m apart do not fit along "
+                    f"the route of scene {scene.name!r}: ({pose[0]:.2f}, {pose[1]:.2f}) "
+                    f"is blocked")
+        for k in range(1, len(points)):
+            a, b = points[k - 1], points[k]
+            if not connected(scene, a, b, radius):
+                raise ValueError(f"route points {k - 1} ({a[0]:.3f}, {a[1]:.3f}) and {k} "
+                                 f"({b[0]:.3f}, {b[1]:.3f}) are not joined by any path for a "
+                                 f"disc of {radius} m radius in scene {scene.name!r}")
+        check_start_jitter(scene, points[0], self.start_jitter[0], radius, "the route's start")
 
     def _check_route_point(self, scene: Scene, k: int, pose: np.ndarray) -> None:
         """``ValueError`` if point ``k`` of the given route lies outside ``scene.bounds``
-        or has less than ``clearance_margin`` metres of clearance."""
+        or closer than the robot's body radius to a wall or object (by how much)."""
         (xmin, ymin), (xmax, ymax) = scene.bounds
         where = f"route point {k} ({pose[0]:.3f}, {pose[1]:.3f})"
         if not (xmin <= pose[0] <= xmax and ymin <= pose[1] <= ymax):
             raise ValueError(f"{where} lies outside the bounds of scene {scene.name!r}: "
                              f"x in [{xmin}, {xmax}], y in [{ymin}, {ymax}] m")
-        free = clearance(scene, (pose[0], pose[1]))
-        if free < self.clearance_margin:
-            raise ValueError(f"{where} is blocked in scene {scene.name!r}: {free:.3f} m from "
-                             f"the nearest wall or object, at least {self.clearance_margin} m "
-                             f"needed")
+        free = max(clearance(scene, (pose[0], pose[1])), 0.0)
+        if free < BODY_RADIUS:
+            raise ValueError(f"{where} is {free:.3f} m from the nearest wall or object in "
+                             f"scene {scene.name!r}; the robot's body needs {BODY_RADIUS:.3f} m "
+                             f"({BODY_RADIUS - free:.3f} m short)")
 
     def sample_episode(self, scene: Scene, rng: np.random.Generator) -> Episode:
         before, *targets = self._route(scene)

@@ -22,6 +22,7 @@ from gymnasium import spaces
 
 from homing_gym.geometry import wrap_angle
 from homing_gym.observations import ObservationKey, constant_key
+from homing_gym.paths import connected
 from homing_gym.scenes.base import Scene
 from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.base import Episode, check_start_jitter
@@ -44,13 +45,16 @@ class WorkLocationsTask(GoalReachingTask):
     """See the module docstring.
 
     ``start_location``/``goal_location``: names of work locations, or ``None`` to draw
-    the path uniformly among the scene's paths that fit. The robot starts at the start
+    the path uniformly among the scene's paths that fit (each joining its two
+    locations for a disc of radius ``clearance_margin``, :data:`START_CLEARANCE`). The robot starts at the start
     location, perturbed uniformly by up to ``start_jitter = (metres, radians)`` (where it
     stopped last time). ``panorama_shape`` is the env camera's ``(H, W)``;
     ``teach_levels`` pyramid steps give the low-resolution images; ``spacing`` (m)
     between taught places; ``template_size`` (pixels, odd) and ``max_points`` of the
     feature maps. ``success_radius``/``success_on`` as in :class:`GoalReachingTask`.
     """
+
+    clearance_margin = START_CLEARANCE
 
     def __init__(self, panorama_shape: tuple[int, int], start_location: str | None = None,
                  goal_location: str | None = None,
@@ -112,10 +116,14 @@ class WorkLocationsTask(GoalReachingTask):
         if not self._candidate_paths(scene):
             raise ValueError(f"scene {scene.name!r} has no path from {self.start_location!r} "
                              f"to {self.goal_location!r}")
-        for start, _ in self._candidate_paths(scene):
-            check_start_jitter(scene, scene.metadata["work_locations"][start],
-                               self.start_jitter[0], START_CLEARANCE,
+        places = scene.metadata["work_locations"]
+        for start, goal in self._candidate_paths(scene):
+            check_start_jitter(scene, places[start], self.start_jitter[0], START_CLEARANCE,
                                f"the work location {start!r}")
+            if not connected(scene, places[start], places[goal], START_CLEARANCE):
+                raise ValueError(f"scene {scene.name!r}: no path for a disc of "
+                                 f"{START_CLEARANCE} m radius leads from the work location "
+                                 f"{start!r} to {goal!r}")
         for key, points in scene.metadata["paths"].items():
             length = float(np.sum(np.linalg.norm(np.diff(points, axis=0), axis=1)))
             if length / self.spacing + len(points) > MAX_PLACES:

@@ -127,9 +127,9 @@ def test_given_route_needs_no_route_origin(make_env):
     ({"route": [(1.0, 0.0), (1.03, 0.0)]}, r"at least 0.05 m apart"),
     ({"route": [(1.0, 0.0), (9.0, 0.0)]}, r"route point 1 \(9.000, 0.000\) lies outside the "
                                           r"bounds .* x in \[0.0, 8.0\]"),
-    ({"route": [(1.0, 0.0), (2.0, 0.85)]}, r"route point 1 \(2.000, 0.850\) is blocked .* "
-                                           r"at least 0.18 m"),
-    ({"route": [(2.7, 0.6), (3.5, 0.0)]}, r"route point 0 .* is blocked"),        # the bin
+    ({"route": [(1.0, 0.0), (2.0, 0.85)]}, r"route point 1 \(2.000, 0.850\) is 0.0\d\d m from "
+                                           r"the nearest wall .* needs 0.160 m"),
+    ({"route": [(2.7, 0.6), (3.5, 0.0)]}, r"route point 0 .* is 0.000 m from"),    # the bin
     ({"route": [(1.0, 0.0), (2.0, 0.0)], "n_targets": 5}, r"n_targets \(5\) and spacing"),
     ({"route": [(1.0, 0.0), (2.0, 0.0)], "spacing": 0.5}, r"spacing \(0.5\)"),
 ])

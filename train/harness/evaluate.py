@@ -229,11 +229,26 @@ def route_summary(episodes: Sequence[EpisodeRecord], seed: int = 0) -> dict[str,
 
 
 # -- running episodes ---------------------------------------------------------------------
-def _geodesic(scene, a, b, radius: float) -> float:
+def _shortest(scene, stops, radius: float, seed: int) -> float:
+    """Length (m) of the shortest path through ``stops`` in order for a disc of ``radius``
+    metres: the paths the oracle plans (:func:`homing_gym.paths.shortest_path`).
+    ``ValueError`` where a leg has none, which no episode the env draws lacks."""
     try:
-        return path_length(shortest_path(scene, a, b, radius))
+        return sum(path_length(shortest_path(scene, a, b, radius))
+                   for a, b in zip(stops[:-1], stops[1:]))
+    except NoPathError as err:
+        raise ValueError(f"episode of seed {seed}: SPL is undefined, no path joins its start "
+                         f"and goals ({err}); the env draws only joined ones, so a start or "
+                         f"home given as a reset option lies out of reach") from err
+
+
+def _remaining(scene, final, home, radius: float) -> float:
+    """Shortest-path distance (m) from where the robot ended to home, for soft-SPL;
+    infinite (soft-SPL 0) where no path leads home from there."""
+    try:
+        return path_length(shortest_path(scene, final, home, radius))
     except NoPathError:
-        return math.dist(a[:2], b[:2])
+        return math.inf
 
 
 def run_episode(env: gym.Env, policy, seed: int, start: Sequence[float] | None = None,
@@ -247,15 +262,14 @@ def run_episode(env: gym.Env, policy, seed: int, start: Sequence[float] | None =
     run = rollout(env, policy, seed, options)
     home = np.asarray(run.reset_info["home_pose"], dtype=np.float64)
     start_pose = np.asarray(run.reset_info["start_pose"], dtype=np.float64)
-    # the scene, the body radius and the episode's goals are public attributes, read for
-    # path-length metrics: the shortest path visits every goal of a route in order
+    # the scene, the task's path radius and the episode's goals are public attributes,
+    # read for path-length metrics: the shortest path visits every goal of a route in order
     unwrapped = env.unwrapped
-    scene, radius = unwrapped.scene, unwrapped.robot_config.body_radius
+    scene, radius = unwrapped.scene, unwrapped.task.path_radius
     traj = run.poses[:, :2]
     final = run.poses[-1]
-    stops = [start_pose, *unwrapped.episode.goals]
-    shortest = sum(_geodesic(scene, a, b, radius) for a, b in zip(stops[:-1], stops[1:]))
-    final_geodesic = _geodesic(scene, final, home, radius)
+    shortest = _shortest(scene, [start_pose, *unwrapped.episode.goals], radius, seed)
+    final_geodesic = _remaining(scene, final, home, radius)
     p = path_length(traj)
     success = bool(run.info.get("is_success", False))
     route = _route_fields(run.info, run.poses[:, :2], unwrapped)

@@ -4,10 +4,13 @@ Definitions (metres, radians unless named otherwise):
 
 * path length ``p``: sum of the distances between consecutive recorded positions;
 * ``spl`` = ``s * l / max(l, p)`` (Anderson et al. 2018), ``s`` success (0/1), ``l`` the
-  shortest collision-free start-home path length (:func:`homing_gym.paths.shortest_path`;
-  on a route, through every target in order);
+  shortest collision-free start-home path length for a disc of the task's
+  ``path_radius`` (:func:`homing_gym.paths.shortest_path`, the path the oracle plans;
+  on a route, through every target in order); every episode the env draws has one, and
+  the harness refuses one without (a start or home given out of reach);
 * ``soft_spl`` = ``max(0, 1 - d_T / l) * l / max(l, p)`` (Datta et al. 2021), ``d_T`` the
-  shortest-path distance from the final position to home;
+  shortest-path distance from the final position to home (infinite, soft-SPL 0, where
+  no path leads home from there);
 * on a route (RouteFollowing-v0; the env's ``info["target_errors"]`` holds the distance
   at which each target was left: on reaching it, or with ``success_on="stop"`` where the
   agent stopped), a target is *reached* when a recorded position comes within the
