@@ -99,3 +99,34 @@ def test_import_finds_a_module_in_the_current_folder(tmp_path, monkeypatch):
     import_user_module("my_world_here")
     assert sys.modules["my_world_here"].LOADED
     assert sys.path[-1] == str(tmp_path)                   # searched last: shadows nothing
+
+
+@pytest.mark.parametrize("prog", ["homing-eval", "homing-suite", "homing-field", "homing-demo"])
+def test_the_commands_that_run_episodes_take_the_same_world_options(prog, capsys):
+    module = importlib.import_module(COMMANDS[prog])
+    with pytest.raises(SystemExit):
+        module.main(["--help"])
+    text = capsys.readouterr().out
+    for option in ("--env ENV", "--env-kwargs JSON", "--scene SCENE", "--import MODULE"):
+        assert option in text, (prog, option)
+
+
+def test_benchmark_runs_in_a_mesh_world_and_refuses_an_unknown_one(tmp_path, capsys):
+    import json
+
+    from homing_gym.benchmark import main
+    from homing_gym.scenes.mesh_example import write_example_room
+
+    write_example_room(tmp_path / "room.obj")
+    world = f"mesh:{tmp_path / 'room.obj'}"
+    out = tmp_path / "bench.json"
+    assert main(["--worlds", world, "--renderers", "raycast", "--shapes", "48x256",
+                 "--steps", "10", "--workers", "1", "--json", str(out)]) == 0
+    (record,) = json.loads(out.read_text())
+    assert record["config"] == f"raycast 48x256 {world}"
+    assert record["env_kwargs"]["scene"] == world and record["env_steps_per_s"] > 0
+    with pytest.raises(SystemExit) as err:
+        main(["--worlds", "moon", "--steps", "10", "--json", str(tmp_path / "no.json")])
+    assert err.value.code == 2
+    assert "world 'moon': neither a benchmark world" in capsys.readouterr().err
+    assert not (tmp_path / "no.json").exists()
