@@ -60,16 +60,16 @@ DEFAULT_FACE_COLOR = (0.7, 0.7, 0.7)
 BOUNDS_MARGIN = 0.05
 
 
-def _reals(value, *shapes: tuple[int, ...]) -> np.ndarray | None:
-    """``value`` as a float array if it has one of ``shapes`` and holds only finite real
-    numbers (no strings or bools), else ``None``."""
+def _reals(value, *shapes: tuple[int, ...]) -> list | None:
+    """``value`` as (nested) lists of floats if it has one of ``shapes`` and holds only
+    finite real numbers (no strings or bools), else ``None``."""
     try:
         items = np.array(value, dtype=object)
     except ValueError:          # ragged nesting
         return None
     if items.shape not in shapes or not all(is_real(v) for v in items.flat):
         return None
-    return items.astype(np.float64)
+    return items.astype(np.float64).tolist()
 
 
 @dataclass(frozen=True)
@@ -117,7 +117,7 @@ class MeshOptions:
         put("offset", tuple(offset))
         if self.bounds is not None:
             box = _reals(self.bounds, (2, 2))
-            if box is None or not np.all(box[0] < box[1]):
+            if box is None or not (box[0][0] < box[1][0] and box[0][1] < box[1][1]):
                 raise bad("bounds", "((xmin, ymin), (xmax, ymax)) finite metres with "
                                     "xmin < xmax and ymin < ymax")
             put("bounds", tuple(map(tuple, box)))
@@ -126,12 +126,12 @@ class MeshOptions:
                 raise bad(name, "True or False (0 or 1 in a scene string)")
             put(name, bool(getattr(self, name)))
         ground = _reals(self.ground_color, (3,), (4,))
-        if ground is None or not np.all((ground >= 0) & (ground <= 1)):
+        if ground is None or not all(0 <= v <= 1 for v in ground):
             raise bad("ground_color", "3 or 4 numbers (RGB or RGBA) in [0, 1]")
         put("ground_color", (*ground, 1.0)[:4])
         if self.sky_color is not None:
             sky = _reals(self.sky_color, (3,))
-            if sky is None or not np.all((sky >= 0) & (sky <= 1)):
+            if sky is None or not all(0 <= v <= 1 for v in sky):
                 raise bad("sky_color", "3 numbers (RGB) in [0, 1], or None")
             put("sky_color", tuple(sky))
         band = _reals(self.height_band, (2,))
@@ -139,8 +139,9 @@ class MeshOptions:
             raise bad("height_band", "(low, high) finite metres with 0 <= low < high")
         put("height_band", tuple(band))
         names = self.no_collision
-        if isinstance(names, str) or not all(isinstance(n, str) and n for n in names):
-            raise bad("no_collision", "a list of part names (non-empty strings)")
+        if not (isinstance(names, (list, tuple))
+                and all(isinstance(n, str) and n for n in names)):
+            raise bad("no_collision", "a list or tuple of part names (non-empty strings)")
         put("no_collision", tuple(names))
 
 
@@ -246,6 +247,11 @@ def load_parts(path: str | os.PathLike) -> list[MeshPart]:
             from None
     meshes = loaded.dump() if isinstance(loaded, trimesh.Scene) else [loaded]
     meshes = [m for m in meshes if isinstance(m, trimesh.Trimesh) and len(m.faces)]
+    if isinstance(loaded, trimesh.Scene):
+        for mesh in meshes:     # dump's copies lose a glTF's vertex colours beside a
+            source = loaded.geometry[mesh.metadata["name"]].visual   # material (trimesh#2153)
+            if "color" in getattr(source, "vertex_attributes", {}):
+                mesh.visual.vertex_attributes["color"] = source.vertex_attributes["color"]
     if not meshes:
         raise ValueError(f"mesh file {path!r} has no triangles (empty, or only points "
                          f"or lines)")
@@ -358,8 +364,9 @@ def _floats(*counts: int) -> Callable[[str], tuple[float, ...]]:
         except ValueError:
             values = ()
         if len(values) not in counts:
-            raise ValueError(f"expected {' or '.join(map(str, counts))} comma-separated "
-                             f"number{'s' if max(counts) > 1 else ''}")
+            raise ValueError("expected a number" if counts == (1,) else
+                             f"expected {' or '.join(map(str, counts))} comma-separated "
+                             f"numbers")
         return values
     return read
 
@@ -404,8 +411,9 @@ def parse_mesh_spec(spec: str) -> tuple[str, MeshOptions]:
         for field in query.split("&") if query else ():
             key, equals, text = field.partition("=")
             if not key:
-                raise ValueError(f"empty option {field!r}: write options as "
-                                 f"mesh:PATH?key=value&key=value")
+                what = f"option {field!r} has no name" if field else "empty option"
+                raise ValueError(f"{what}: write options as key=value joined by '&', "
+                                 f"e.g. mesh:PATH?scale=0.01&up=y")
             _check_option_name(key)
             if not equals:
                 raise ValueError(f"option {key!r} has no value: write {key}=VALUE")
