@@ -116,7 +116,7 @@ def test_given_route_needs_no_route_origin(make_env):
 @pytest.mark.parametrize("kwargs, message", [
     ({"route": [(1.0, 0.0)]}, "at least two points"),
     ({"route": []}, "at least two points"),
-    ({"route": "1,0 2,0"}, "at least two points"),
+    ({"route": "1,0 2,0"}, "route file '1,0 2,0': unknown format"),   # a string: a path
     ({"route": [(1.0, 0.0), (2.0, float("nan"))]}, r"route point 1 must be .* finite"),
     ({"route": [(1.0, 0.0), (2.0, 0.0, float("inf"))]}, r"route point 1 must be .* finite"),
     ({"route": [(1.0, 0.0), (2.0,)]}, r"route point 1 must be \(x, y\) or \(x, y, yaw\)"),
