@@ -272,11 +272,14 @@ def _cut_columns(n: int, p: np.ndarray, H: int, even_rows: bool, top_angle: floa
 @njit(cache=True, error_model="numpy")
 def _fill_rows(n: int, triangle: np.ndarray, column: np.ndarray, cut: np.ndarray,
                tan_elev: np.ndarray, even_rows: bool, weighted: np.ndarray, hit: np.ndarray,
-               weights: np.ndarray, depth: np.ndarray) -> None:
+               weights: np.ndarray, depth: np.ndarray, listed: np.ndarray, drawn: np.ndarray,
+               m: int) -> int:
     """The rows of the first ``n`` cut pairs (:func:`_cut_columns`): each ray of the
     column between the segment's ends hits it at a distance found in closed form; the
     nearest hit so far per pixel wins. With ``even_rows`` every column's rows are read
-    from the first column, so that the image's memory stays in the cache."""
+    from the first column, so that the image's memory stays in the cache. Appends to
+    ``drawn[:m]`` the triangles not yet ``listed`` that win a pixel; returns the new
+    ``m``."""
     H, C = tan_elev.shape[0], CHUNK
     for k in range(n):
         if cut[_OK * C + k] == 0.0:
@@ -295,6 +298,7 @@ def _fill_rows(n: int, triangle: np.ndarray, column: np.ndarray, cut: np.ndarray
             first -= 1
         while first < H and tan_elev[first, jr] > top:
             first += 1
+        wins = False
         for i in range(first, H):
             ti = tan_elev[i, jr]
             if ti < lowest:
@@ -306,12 +310,18 @@ def _fill_rows(n: int, triangle: np.ndarray, column: np.ndarray, cut: np.ndarray
             u = min(max(fa / (fa - fb), 0.0), 1.0)
             dist = a0 + u * da
             if dist < depth[j, i]:
+                wins = True
                 depth[j, i] = dist
                 hit[i, j] = t
                 if with_weights:
                     weights[i, j, 0] = w0 + u * dw0
                     weights[i, j, 1] = w1 + u * dw1
                     weights[i, j, 2] = w2 + u * dw2
+        if wins and not listed[t]:
+            listed[t] = True
+            drawn[m] = t
+            m += 1
+    return m
 
 
 @njit(cache=True, error_model="numpy")
@@ -319,7 +329,7 @@ def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
                  origin: np.ndarray, yaw: float, beta: np.ndarray, tan_elev: np.ndarray,
                  circle: bool, even_rows: bool, top_angle: np.ndarray,
                  rows_per_radian: np.ndarray, weighted: np.ndarray, hit: np.ndarray,
-                 weights: np.ndarray, depth: np.ndarray) -> None:
+                 weights: np.ndarray, depth: np.ndarray, drawn: np.ndarray) -> int:
     """Nearest triangle per pixel.
 
     ``corners (9, N)``: the triangles' world corners coordinate by coordinate (``x0,
@@ -338,7 +348,8 @@ def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
     of the hit where the triangle is ``weighted`` (``(N,)`` bool: the shader needs them,
     for a texture or a shadow; elsewhere left as they were); ``depth (W, H)`` is scratch
     (the nearest hit's horizontal distance so far, column by column like the loops
-    below), overwritten.
+    below), overwritten. Returns ``m`` and writes ``drawn[:m]`` (``drawn (N,)``): every
+    triangle that won a pixel at some point, once (a superset of those in ``hit``).
 
     Three passes: the triangles' bearing spans, all at once (:func:`triangle_spans`);
     the pairs of a triangle and a column in its span, cut :data:`CHUNK` at a time
@@ -371,7 +382,8 @@ def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
     for t in range(N):
         seen[m] = t
         m += ranges[1, t] > 0
-    n = 0
+    n = shown = 0
+    listed = np.zeros(N, np.bool_)
     ox, oy, oz = origin[0], origin[1], origin[2]
     for t in seen[:m]:
         x0, y0, z0 = corners[0, t] - ox, corners[1, t] - oy, corners[2, t] - oz
@@ -391,11 +403,12 @@ def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
                 n += 1
                 if n == CHUNK:
                     _cut_columns(n, p, H, even_rows, top_angle[0], rows_per_radian[0], cut)
-                    _fill_rows(n, triangle, column, cut, tan_elev, even_rows, weighted, hit,
-                               weights, depth)
+                    shown = _fill_rows(n, triangle, column, cut, tan_elev, even_rows, weighted,
+                                       hit, weights, depth, listed, drawn, shown)
                     n = 0
     _cut_columns(n, p, H, even_rows, top_angle[0], rows_per_radian[0], cut)
-    _fill_rows(n, triangle, column, cut, tan_elev, even_rows, weighted, hit, weights, depth)
+    return _fill_rows(n, triangle, column, cut, tan_elev, even_rows, weighted, hit, weights,
+                      depth, listed, drawn, shown)
 
 
 @njit(cache=True, error_model="numpy")

@@ -202,7 +202,7 @@ class RayCaster:
         self._lit_key: tuple | None = None
         self._light = np.zeros(3)            # the unit light direction of ``_lit_key``
         self._all = np.arange(len(self._tris))
-        self._open = np.flatnonzero(~self._closed)
+        self._drawn = np.empty(len(self._tris), np.int64)    # the caster's drawn triangles
 
     def _shadow_map(self, lighting: Lighting) -> ShadowMap:
         key = tuple(lighting.direction)
@@ -210,11 +210,12 @@ class RayCaster:
             self._shadow_maps[key] = shadow_map(self._tris, lighting.direction)
         return self._shadow_maps[key]
 
-    def _lit(self, light: Lighting, origin: np.ndarray) -> np.ndarray:
-        """Each triangle's lit colour seen from ``origin`` (:func:`lit_colors`): those of
-        closed solids computed once per light, the open ones for every image."""
+    def _lit(self, light: Lighting, origin: np.ndarray, drawn: np.ndarray) -> np.ndarray:
+        """The lit colours (:func:`lit_colors`) of the triangles the image shows seen
+        from ``origin``: those of closed solids computed once per light, the open ones
+        among ``drawn`` (those the caster drew) for every image."""
         key = (tuple(light.direction), light.ambient, light.diffuse)
-        which = self._open
+        which = drawn[~self._closed[drawn]]
         if self._lit_key != key:
             direction = np.asarray(light.direction, np.float64)
             self._lit_key, self._light = key, direction / np.linalg.norm(direction)
@@ -240,12 +241,13 @@ class RayCaster:
         hit, weights, depth = self._buffers(H, W)
         origin = np.array([x, y, camera_height])
         weighted = self._everywhere if self.shadows else self._textured
-        cast_columns(self._corners, self._normals_by_axis, self._closed, origin, yaw, *rays,
-                     weighted, hit, weights, depth)
+        drawn = self._drawn[:cast_columns(self._corners, self._normals_by_axis, self._closed,
+                                          origin, yaw, *rays, weighted, hit, weights, depth,
+                                          self._drawn)]
         image = np.empty((H // k, W // k, 3), np.uint8)
         light = lighting or DEFAULT_LIGHTING
         shadow = self._shadow_map(light) if self.shadows else _NO_SHADOWS
-        shade(hit, weights, self._lit(light, origin), self._texture,
+        shade(hit, weights, self._lit(light, origin, drawn), self._texture,
               self._uvs, self._atlas, self._levels, self._first_level, self._texel_density,
               self._tris, self._normals, origin, spacing, self.sky, image,
               self.mesh.colors * light.ambient if self.shadows else self.mesh.colors,

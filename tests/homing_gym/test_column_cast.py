@@ -32,10 +32,12 @@ def _cast(mesh, pose, rays, weighted=None):
     depth = np.empty((W, H))
     if weighted is None:
         weighted = np.ones(len(mesh.triangles), np.bool_)
-    cast_columns(np.ascontiguousarray(mesh.triangles.reshape(-1, 9).T),
-                 np.ascontiguousarray(mesh.normals.T), mesh.closed, np.array([x, y, height]),
-                 yaw, *rays, weighted, hit, weights, depth)
-    return hit, weights, depth.T
+    drawn = np.empty(len(mesh.triangles), np.int64)
+    shown = cast_columns(np.ascontiguousarray(mesh.triangles.reshape(-1, 9).T),
+                         np.ascontiguousarray(mesh.normals.T), mesh.closed,
+                         np.array([x, y, height]), yaw, *rays, weighted, hit, weights, depth,
+                         drawn)
+    return hit, weights, depth.T, drawn[:shown]
 
 
 def test_the_approximate_arctangent_is_within_its_stated_error():
@@ -64,8 +66,8 @@ def test_dropping_segments_between_rows_changes_no_pixel(rocks):
     mesh, poses = rocks
     rays = panorama_rays((48, 256), math.radians(60), 2)
     for pose in poses:
-        dropped, _, near = _cast(mesh, pose, rays)
-        searched, _, far = _cast(mesh, pose, rays._replace(even_rows=False))
+        dropped, _, near, _ = _cast(mesh, pose, rays)
+        searched, _, far, _ = _cast(mesh, pose, rays._replace(even_rows=False))
         assert np.array_equal(dropped, searched) and np.array_equal(near, far)
         assert (dropped >= 0).mean() > 0.4                  # the rocks, walls and floor
 
@@ -78,8 +80,8 @@ def test_columns_found_by_arithmetic_are_those_found_by_search(rocks):
     rays = panorama_rays((48, 256), math.radians(60), 1)
     part = camera_rays(rays.beta[:-1].copy(), rays.tan_elev[:, :-1])
     for pose in poses:
-        circle, _, _ = _cast(mesh, pose, rays)
-        searched, _, _ = _cast(mesh, pose, part)
+        circle, _, _, _ = _cast(mesh, pose, rays)
+        searched, _, _, _ = _cast(mesh, pose, part)
         assert np.array_equal(circle[:, :-1], searched)
 
 
@@ -89,8 +91,8 @@ def test_weights_are_written_only_where_the_shader_reads_them(rocks):
     rng = np.random.default_rng(1)
     weighted = rng.random(len(mesh.triangles)) < 0.5
     for pose in poses[:3]:
-        hit, weights, _ = _cast(mesh, pose, rays, weighted=weighted)
-        every, all_weights, _ = _cast(mesh, pose, rays)
+        hit, weights, _, _ = _cast(mesh, pose, rays, weighted=weighted)
+        every, all_weights, _, _ = _cast(mesh, pose, rays)
         assert np.array_equal(hit, every)
         seen = hit >= 0
         needed = seen & weighted[np.maximum(hit, 0)]
@@ -99,6 +101,16 @@ def test_weights_are_written_only_where_the_shader_reads_them(rocks):
         np.testing.assert_allclose(all_weights[seen].sum(1), 1.0, atol=1e-9)
         none = np.zeros(len(mesh.triangles), np.bool_)
         assert np.isnan(_cast(mesh, pose, rays, weighted=none)[1]).all()
+
+
+def test_the_drawn_triangles_are_listed_once_and_include_every_one_hit(rocks):
+    """The shader lights only the triangles the caster lists as drawn."""
+    mesh, poses = rocks
+    for rays in (panorama_rays((48, 256), math.radians(60), 2), perspective_rays(80, 60, 70.0)):
+        for pose in poses:
+            hit, _, _, drawn = _cast(mesh, pose, rays)
+            assert len(set(drawn)) == len(drawn)
+            assert set(np.unique(hit[hit >= 0])) <= set(drawn)
 
 
 @pytest.mark.parametrize("turns", [-3, -1, 1, 3])
@@ -110,8 +122,8 @@ def test_any_heading_gives_the_picture_of_the_same_heading_within_one_turn(rocks
     mesh, poses = rocks
     for rays in (panorama_rays((48, 256), math.radians(60), 1), perspective_rays(80, 60, 70.0)):
         for x, y, yaw, height in poses[:4]:
-            near, _, _ = _cast(mesh, (x, y, yaw, height), rays)
-            far, _, _ = _cast(mesh, (x, y, yaw + 2 * math.pi * turns, height), rays)
+            near = _cast(mesh, (x, y, yaw, height), rays)[0]
+            far = _cast(mesh, (x, y, yaw + 2 * math.pi * turns, height), rays)[0]
             assert (near >= 0).mean() > 0.4
             assert (far != near).mean() < 1e-3          # cos(yaw + beta) rounds differently
 

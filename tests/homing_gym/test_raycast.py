@@ -179,7 +179,7 @@ def test_every_pixel_hits_what_embree_hits(scene):
             hit, weights = np.empty((H, W), np.int64), np.empty((H, W, 3))
             cast_columns(tris.reshape(-1, 9).T.copy(), mesh.normals.T.copy(), mesh.closed,
                          origin, yaw, *rays, np.ones(len(tris), np.bool_), hit, weights,
-                         np.empty((W, H)))
+                         np.empty((W, H)), np.empty(len(tris), np.int64))
             cos_e = 1 / np.sqrt(1 + tan ** 2)
             dirs = np.stack([cos_e * np.cos(yaw + beta), cos_e * np.sin(yaw + beta),
                              cos_e * tan], -1).reshape(-1, 3).astype(np.float32)
