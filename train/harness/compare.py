@@ -72,11 +72,13 @@ def route_table(results: Sequence[EvalResult]) -> str:
     for r in routes:
         s = r.summary
         error = "-" if s["target_error_mean"] is None else f"{100 * s['target_error_mean']:.1f}"
+        within = _ci(s, "all_targets_within_radius_rate", "all_targets_within_radius_ci", 100,
+                     ".1f")
         rows.append(
             f"| {r.policy} | {s['route_episodes']} "
             f"| {_ci(s, 'targets_reached_fraction', 'targets_reached_fraction_ci', 100, '.1f')} "
             f"| {_ci(s, 'reached_rate', 'reached_ci', 100, '.1f')} "
-            f"| {_ci(s, 'all_targets_within_radius_rate', 'all_targets_within_radius_ci', 100, '.1f')} "
+            f"| {within} "
             f"| {s['targets_finished_mean']:.1f} | {error} |")
     return "\n".join(rows) + "\n"
 

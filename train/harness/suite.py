@@ -9,8 +9,9 @@ Evaluates every registered scripted controller made for the env and its scene
 (``train/shipped/*.zip`` with the evaluation settings of its ``*.yml``:
 ``eval_env_kwargs``, ``eval_params``, and the controllers' time:
 :func:`~homing_train.harness.matrix.equal_time_kwargs`), every row under the same
-``--env-kwargs``/``--scene``, with the same harness on the same seeded episodes (episode ``i`` uses seed ``seed + i``), writes one
-``<method>.json``/``.csv`` per method into ``--out``, then runs ``homing-compare`` on them:
+``--env-kwargs``/``--scene``, with the same harness on the same seeded episodes (episode
+``i`` uses seed ``seed + i``), writes one ``<method>.json``/``.csv`` per method into
+``--out``, then runs ``homing-compare`` on them:
 ``table.md`` (printed), ``success_vs_distance.png``, ``final_distance.png`` and
 ``trajectories.png``.
 
