@@ -17,23 +17,23 @@ colour (glTF ``baseColorFactor``, OBJ ``Kd``), times the vertex colours where a 
 both. A texture without UVs shows as its mean colour. Alpha is ignored (all opaque).
 
 The options (:class:`MeshOptions`), as keywords of :meth:`MeshScene.from_file` or after
-``?`` in the scene string (values there are taken literally, lists comma-separated):
+``?`` in the scene string, taken literally (lists comma-separated); each once:
 
-============  =====================  ==================  ====================================
-option        scene-string value     default             meaning
-============  =====================  ==================  ====================================
-scale         ``0.0254``             1                   metres per mesh unit
-up            ``z`` or ``y``         z                   the mesh's up axis, turned onto +z
-offset        ``x,y,z``              0,0,0               metres, added after scale and turn
-bounds        ``xmin,ymin,xmax,ymax`` blocking footprint  free floor (metres), at most 100 m
-fence         ``0`` or ``1``         1                   invisible walls along the bounds
-ground_plane  ``0`` or ``1``         1                   draw a floor 2 mm below z = 0
-ground_color  ``r,g,b`` or ``r,g,b,a`` 0.55,0.55,0.55,1  the floor's colour, each in [0, 1]
-sky_color     ``r,g,b``              the env's           ray caster background, in [0, 1]
-height_band   ``low,high``           0.02,0.35           metres in which triangles block
-collision     ``0`` or ``1``         1                   whether the mesh blocks the robot
-no_collision  ``name,name``          none                parts the robot passes through
-============  =====================  ==================  ====================================
+==============  ========================  ====================  ==============================
+option          scene-string value        default               meaning
+==============  ========================  ====================  ==============================
+scale           ``0.0254``                1                     metres per mesh unit
+up              ``z`` or ``y``            z                     the mesh's up axis (to +z)
+offset          ``x,y,z``                 0,0,0                 metres, added last
+bounds          ``xmin,ymin,xmax,ymax``   blocking footprint    free floor (m), <= 100 m a side
+fence           ``0`` or ``1``            1                     invisible walls on the bounds
+ground_plane    ``0`` or ``1``            1                     a floor 2 mm below z = 0
+ground_color    ``r,g,b`` or ``r,g,b,a``  0.55,0.55,0.55,1      its colour, in [0, 1]
+sky_color       ``r,g,b``                 the env's             ray caster background, [0, 1]
+height_band     ``low,high``              0.02,0.35             metres in which faces block
+collision       ``0`` or ``1``            1                     ``0``: nothing blocks
+no_collision    ``name,name``             none                  parts the robot passes through
+==============  ========================  ====================  ==============================
 
 e.g. ``"mesh:/data/office.glb?scale=0.0254&bounds=-10,-8,10,8&no_collision=curtain"``.
 """
