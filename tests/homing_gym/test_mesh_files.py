@@ -52,7 +52,8 @@ def _write_obj(folder: Path, name: str, materials: dict[str, str], *, uvs: bool)
     for k, material in enumerate(materials):
         box = _box((2.0 * k, 0.0))
         lines += [f"v {x} {y} {z}" for x, y, z in box.vertices]
-        lines += [f"vt {u % 1:.3f} {u // 1 / 8:.3f}" for u in np.arange(8) * 0.37] if uvs else []
+        if uvs:
+            lines += [f"vt {u % 1:.3f} {u // 1 / 8:.3f}" for u in np.arange(8) * 0.37]
         lines.append(f"usemtl {material}")
         base = 8 * k + 1
         lines += ["f " + " ".join(f"{base + i}/{base + i}" if uvs else f"{base + i}"
@@ -64,8 +65,10 @@ def _write_obj(folder: Path, name: str, materials: dict[str, str], *, uvs: bool)
     return path
 
 
-def _data_uri(array: np.ndarray, mime: str) -> str:
-    return f"data:{mime};base64," + base64.b64encode(array.tobytes()).decode()
+def _buffer(array: np.ndarray) -> dict:
+    """A glTF buffer holding ``array``, inline."""
+    return {"byteLength": array.nbytes, "uri": "data:application/gltf-buffer;base64,"
+            + base64.b64encode(array.tobytes()).decode()}
 
 
 def _write_gltf(path: Path, *, colors=None, uvs=None, material=None) -> Path:
@@ -79,16 +82,14 @@ def _write_gltf(path: Path, *, colors=None, uvs=None, material=None) -> Path:
     if uvs is not None:
         arrays["TEXCOORD_0"] = np.asarray(uvs, np.float32)
     indices = np.array([0, 1, 2, 0, 2, 3], np.uint32)
-    kinds = {1: "SCALAR", 2: "VEC2", 3: "VEC3", 4: "VEC4"}
     accessors = [{"bufferView": 0, "componentType": 5125, "count": 6, "type": "SCALAR"}]
-    buffers = [{"byteLength": indices.nbytes, "uri": _data_uri(indices, "application/gltf-buffer")}]
+    buffers = [_buffer(indices)]
     attributes = {}
     for k, (name, array) in enumerate(arrays.items(), start=1):
         attributes[name] = k
-        buffers.append({"byteLength": array.nbytes,
-                        "uri": _data_uri(array, "application/gltf-buffer")})
+        buffers.append(_buffer(array))
         accessor = {"bufferView": k, "componentType": 5126, "count": len(array),
-                    "type": kinds[array.shape[1]]}
+                    "type": f"VEC{array.shape[1]}"}
         if name == "POSITION":
             accessor |= {"min": array.min(axis=0).tolist(), "max": array.max(axis=0).tolist()}
         accessors.append(accessor)
@@ -265,13 +266,14 @@ def test_bad_mesh_options_in_python_are_named(room, tmp_path):
         MeshScene.from_file(tmp_path)
 
 
-# the third-party validation worlds (docs/scenes.md): scene string, triangles
+# the third-party validation worlds as docs/scenes.md gives them: scene string, triangles
 WORLDS = Path(__file__).resolve().parents[2] / ".." / "shared" / "worlds"
 REAL_WORLDS = {
-    "cpr_inspection_outdoor": ("cpr_inspection_outdoor/inspection_world.glb?up=z", 5_767),
-    "willowgarage_office": ("willowgarage_office/willowgarage_visual.glb?scale=0.0254&up=z",
-                            13_839),
-    "samurai_monastery": ("samurai_monastry.obj?up=y", 124_789),
+    "cpr_inspection_outdoor": (
+        "cpr_inspection_outdoor/inspection_world.glb?up=z&bounds=-18,-7.5,24,30", 5_767),
+    "willowgarage_office": (
+        "willowgarage_office/willowgarage_visual.glb?scale=0.0254&up=z", 13_839),
+    "samurai_monastery": ("samurai_monastry.obj?up=y&bounds=-10.8,-9.6,10.8,9.7", 124_789),
 }
 
 
