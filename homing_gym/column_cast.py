@@ -232,7 +232,8 @@ _COS, _SIN, _TOP_ANGLE, _ROWS_PER_RADIAN = 9, 10, 11, 12
 #: arctangents (under 1e-4 rows at 0.01 rad a row).
 _ROW_SLACK = 1e-3
 #: Rows of :func:`_cut_columns`' output.
-_OK, _A0, _H0, _A1, _H1, _W00, _W01, _W02, _W10, _W11, _W12, _TOP, _LOW, _GUESS = range(14)
+(_OK, _A0, _H0, _A1, _H1, _W00, _W01, _W02, _W10, _W11, _W12, _TOP, _LOW, _GUESS,
+ _END_GUESS) = range(15)
 
 
 @njit(cache=True, error_model="numpy")
@@ -267,6 +268,55 @@ def _cut_columns(n: int, p: np.ndarray, H: int, even_rows: bool, top_angle: floa
         out[_W10 * C + k], out[_W11 * C + k], out[_W12 * C + k] = w1
         out[_TOP * C + k], out[_LOW * C + k] = top, low
         out[_GUESS * C + k] = min(max(math.ceil(upper), 0.0), float(H))
+        out[_END_GUESS * C + k] = min(max(math.floor(lower) + 1.0, 0.0), float(H))
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _row_hit(ti: float, a0: float, h0: float, a1: float, h1: float, da: float, depth: float):
+    """``(closer, u, dist)``: where the ray of elevation tangent ``ti`` meets the
+    segment from ``(a0, h0)`` to ``(a1, h1)`` (``u`` the fraction of the way), and whether
+    that is nearer than ``depth``; no branch."""
+    fa = h0 - ti * a0
+    fb = h1 - ti * a1
+    u = min(max(fa / (fa - fb), 0.0), 1.0)
+    dist = a0 + u * da
+    return (dist < depth) & (fa != fb), u, dist
+
+
+@njit(cache=True, error_model="numpy")
+def _rows(first: int, end: int, t: int, j: int, jr: int, tan_elev: np.ndarray, a0: float,
+          h0: float, a1: float, h1: float, da: float, hit: np.ndarray, depth: np.ndarray) -> bool:
+    """Rows ``first <= i < end`` of column ``j`` (tangents from column ``jr``) where
+    triangle ``t``'s segment is nearest so far take it; whether any did. No branch, and
+    unsigned indices (numba reads them without testing for negative ones): vectorised."""
+    wins = 0
+    ju, jru = np.uint64(j), np.uint64(jr)
+    for q in range(end - first):
+        i = np.uint64(first + q)
+        closer, _, dist = _row_hit(tan_elev[i, jru], a0, h0, a1, h1, da, depth[ju, i])
+        depth[ju, i] = dist if closer else depth[ju, i]
+        hit[i, ju] = t if closer else hit[i, ju]
+        wins += closer
+    return wins > 0
+
+
+@njit(cache=True, error_model="numpy")
+def _rows_weighted(first: int, end: int, t: int, j: int, jr: int, tan_elev: np.ndarray,
+                   a0: float, h0: float, a1: float, h1: float, da: float, w0: float, w1: float,
+                   w2: float, dw0: float, dw1: float, dw2: float, hit: np.ndarray,
+                   weights: np.ndarray, depth: np.ndarray) -> bool:
+    """:func:`_rows`, also writing the barycentric weights of the hits."""
+    wins = False
+    for i in range(first, end):
+        closer, u, dist = _row_hit(tan_elev[i, jr], a0, h0, a1, h1, da, depth[j, i])
+        if closer:
+            wins = True
+            depth[j, i] = dist
+            hit[i, j] = t
+            weights[i, j, 0] = w0 + u * dw0
+            weights[i, j, 1] = w1 + u * dw1
+            weights[i, j, 2] = w2 + u * dw2
+    return wins
 
 
 @njit(cache=True, error_model="numpy")
@@ -292,31 +342,23 @@ def _fill_rows(n: int, triangle: np.ndarray, column: np.ndarray, cut: np.ndarray
         da = a1 - a0
         dw0, dw1, dw2 = cut[_W10 * C + k] - w0, cut[_W11 * C + k] - w1, cut[_W12 * C + k] - w2
         lowest = cut[_LOW * C + k]
-        # the first row at or below the segment's top: walked to from the guess
+        # the first row at or below the segment's top and the first below its bottom:
+        # walked to from their guesses
         top, first = cut[_TOP * C + k], int(cut[_GUESS * C + k])
         while first > 0 and tan_elev[first - 1, jr] <= top:
             first -= 1
         while first < H and tan_elev[first, jr] > top:
             first += 1
-        wins = False
-        for i in range(first, H):
-            ti = tan_elev[i, jr]
-            if ti < lowest:
-                break
-            fa = h0 - ti * a0
-            fb = h1 - ti * a1
-            if fa == fb:
-                continue
-            u = min(max(fa / (fa - fb), 0.0), 1.0)
-            dist = a0 + u * da
-            if dist < depth[j, i]:
-                wins = True
-                depth[j, i] = dist
-                hit[i, j] = t
-                if with_weights:
-                    weights[i, j, 0] = w0 + u * dw0
-                    weights[i, j, 1] = w1 + u * dw1
-                    weights[i, j, 2] = w2 + u * dw2
+        end = max(int(cut[_END_GUESS * C + k]), first)
+        while end > first and tan_elev[end - 1, jr] < lowest:
+            end -= 1
+        while end < H and tan_elev[end, jr] >= lowest:
+            end += 1
+        if with_weights:
+            wins = _rows_weighted(first, end, t, j, jr, tan_elev, a0, h0, a1, h1, da, w0, w1,
+                                  w2, dw0, dw1, dw2, hit, weights, depth)
+        else:
+            wins = _rows(first, end, t, j, jr, tan_elev, a0, h0, a1, h1, da, hit, depth)
         if wins and not listed[t]:
             listed[t] = True
             drawn[m] = t
@@ -375,7 +417,7 @@ def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
         _searched_columns(lo, hi, kind, beta, per_radian, ranges)
     p = np.empty(13 * CHUNK)
     triangle, column = np.empty(CHUNK, np.int64), np.empty(CHUNK, np.int64)
-    cut = np.empty(14 * CHUNK)
+    cut = np.empty(15 * CHUNK)
     # the triangles with columns, listed without a branch (a skip would be mispredicted)
     seen = np.empty(N, np.int64)
     m = 0
