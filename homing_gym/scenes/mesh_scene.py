@@ -270,18 +270,18 @@ def _part(mesh, name: str) -> MeshPart:
     uvs = texture = None
     try:
         if visual.kind == "face":
-            face_colors = _rgb(visual.face_colors, len(part.faces), "face") / 255
-        elif visual.kind in ("vertex", "texture"):
+            face_colors = _rgb(visual.face_colors, len(part.faces), "face")
+        else:
             if visual.kind == "vertex":
                 colors = _rgb(visual.vertex_colors, count, "vertex")
-            else:
+            elif visual.kind == "texture":
                 colors, uvs, texture = _material_colors(visual, count)
-            face_colors = colors[part.faces].mean(axis=1) / 255
-        else:
-            return part
+            else:                   # no colours in the file
+                return part
+            face_colors = colors[part.faces].mean(axis=1)
     except ValueError as error:
         raise ValueError(f"mesh part {name!r}: {error}") from None
-    return replace(part, face_colors=face_colors, uvs=uvs, texture=texture)
+    return replace(part, face_colors=face_colors / 255, uvs=uvs, texture=texture)
 
 
 def _rgb(colors, count: int, what: str) -> np.ndarray:

@@ -18,10 +18,19 @@ from PIL import Image
 from homing_gym.scenes import MeshScene, scene_factory
 from homing_gym.scenes.base import HEIGHT_BAND, clearance
 from homing_gym.scenes.mesh_example import PILLAR, write_example_room
-from homing_gym.scenes.mesh_scene import SPEC_OPTIONS, MeshOptions, parse_mesh_spec
+from homing_gym.scenes.mesh_scene import (SPEC_OPTIONS, MeshOptions, _cached_scene,
+                                          parse_mesh_spec)
 
 BOUNDS = ((-3.0, -3.0), (3.0, 3.0))
 GREEN = (30, 200, 30)
+
+
+@pytest.fixture(autouse=True)
+def forget_scene_strings():
+    """Scenes read from "mesh:" strings stay cached in the process: none outlives its test
+    here (other tests count the live mesh scenes)."""
+    yield
+    _cached_scene.cache_clear()
 
 
 def _box(centre=(0.0, 0.0)) -> trimesh.Trimesh:
