@@ -80,7 +80,9 @@ class LocalHomingEnv(HomingEnv):
 
     Home: a uniformly drawn pose with at least 0.22 m of clearance from walls and
     landmarks. Start: at a distance drawn uniformly from ``start_distance`` = (0.3, 1.5) m
-    in a random direction from home, also collision-free, with a uniform random heading.
+    in a random direction from home, also 0.22 m clear and joined to home by a path for a
+    disc of 0.22 m radius (redrawn otherwise: never in another room or a closed pocket;
+    the oracle drives, and SPL measures, that path), with a uniform random heading.
     Everything is drawn from the generator seeded by ``reset(seed=...)``.
     ``reset(options={"home": (x, y, yaw), "start": (x, y, yaw)})`` sets either pose
     instead (metres, radians; e.g. to place the robot on a grid for a homing vector field;
@@ -236,7 +238,8 @@ class RouteFollowingEnv(HomingEnv):
     counter-clockwise from +x, e.g. ``[(1, 0), (2, 0.3), (3, 0)]``: the first is where the
     robot starts, the others are the targets in order; a missing yaw is the direction of
     travel from the previous point; consecutive points at least 0.05 m apart, every point
-    inside the scene with 0.18 m of clearance; replaces the straight route, so
+    inside the scene with room for the robot's body, 0.16 m of clearance, and joined to
+    the next by a path for it; replaces the straight route, so
     ``n_targets`` and ``spacing`` must then keep their defaults), ``start_jitter``,
     ``success_radius``, ``success_on``, ``reward``, ``lighting_change`` = 0 (0-1: strength
     of the illumination change between snapshots and run: light direction, brightness,
@@ -398,8 +401,9 @@ class LandmarkNavigationEnv(HomingEnv):
     ## Starting state
 
     The goal id is drawn uniformly among the landmarks present; the start uniformly on
-    the floor of the rooms and the corridor (at least 0.25 m from walls and objects, not
-    already in front of the goal), with a uniform heading. With ``remove_landmarks`` =
+    the floor of the rooms and the corridor (at least 0.25 m from walls and objects,
+    joined to the goal's standing pose by a path for a disc of that radius, not already
+    in front of the goal), with a uniform heading. With ``remove_landmarks`` =
     q > 0 each landmark is missing from the episode with probability q (never all); with
     ``occlude_landmarks`` = q > 0 each remaining one is partly hidden with probability q
     by a dark board (0.3 m wide, 0.8 m tall) standing 0.3 m in front of it, shifted
