@@ -35,6 +35,7 @@ import numpy as np  # noqa: E402
 
 from homing_gym.cli import command_parser, env_kwargs_from_args  # noqa: E402
 from homing_gym.geometry import wrap_angle  # noqa: E402
+from homing_gym.paths import connected  # noqa: E402
 from homing_gym.scenes.base import clearances  # noqa: E402
 from homing_gym.topdown import MapCanvas, draw_pose, draw_scale_bar, draw_scene  # noqa: E402
 from homing_train.harness.evaluate import (DEFAULT_ENV, add_policy_arguments,  # noqa: E402
@@ -72,9 +73,12 @@ class FieldResult:
 MAX_GRID_POINTS = 20_000
 
 
-def grid_points(scene, home, spacing: float, margin: float, exclude: float) -> np.ndarray:
+def grid_points(scene, home, spacing: float, margin: float, exclude: float,
+                path_radius: float) -> np.ndarray:
     """Cell centres of a ``spacing`` grid over the scene bounds with at least ``margin`` m
-    clearance and more than ``exclude`` m from home."""
+    clearance, more than ``exclude`` m from home and joined to home by a path for a disc
+    of ``path_radius`` m (:func:`homing_gym.paths.connected`: the starts the task itself
+    could draw; a point in a closed pocket has no way home)."""
     if not spacing > 0:
         raise ValueError(f"grid spacing must be positive metres, got {spacing}")
     (xmin, ymin), (xmax, ymax) = scene.bounds
@@ -89,7 +93,8 @@ def grid_points(scene, home, spacing: float, margin: float, exclude: float) -> n
     pts = np.column_stack([gx.ravel(), gy.ravel()])
     keep = (clearances(scene, pts) >= margin) & (
         np.hypot(pts[:, 0] - home[0], pts[:, 1] - home[1]) > exclude)
-    return pts[keep]
+    return np.array([p for p in pts[keep] if connected(scene, p, home, path_radius)],
+                    dtype=np.float64).reshape(-1, 2)
 
 
 PROBE_STEPS = 40
@@ -135,9 +140,10 @@ def homing_field(policy, env_id: str = DEFAULT_ENV, grid: float = 0.2, seed: int
         u = env.unwrapped
         home = np.asarray(info["home_pose"], dtype=np.float64)
         radius = getattr(u.task, "success_radius", 0.15)
-        xy = grid_points(u.scene, home, grid, margin, radius)
+        xy = grid_points(u.scene, home, grid, margin, radius, u.task.path_radius)
         if len(xy) == 0:
-            raise ValueError(f"no grid point with {margin} m clearance at spacing {grid} m")
+            raise ValueError(f"no grid point with {margin} m clearance and a path home at "
+                             f"spacing {grid} m")
         headings = np.random.default_rng(seed).uniform(-np.pi, np.pi, len(xy))
         points = np.column_stack([xy, headings])
         controller = spec.build()

@@ -39,6 +39,7 @@ from tqdm.auto import tqdm
 
 import homing_baselines
 from homing_baselines.motion import MotionHelper
+from homing_gym.paths import connected
 from homing_gym.scenes.base import Scene, clearance
 from homing_gym.tasks.base import sample_free_pose
 from homing_train.harness.rollout import prepare_policy
@@ -137,9 +138,10 @@ def render_bank(env: gym.Env | Sequence[gym.Env], positions_per_scene: int, scen
 
 
 def pair_set(bank: PoseBank, n_pairs: int, distance: tuple[float, float], oracle,
-             rng: np.random.Generator, progress: bool = True) -> PairSet:
+             rng: np.random.Generator, radius: float, progress: bool = True) -> PairSet:
     """``n_pairs`` (current, home) pairs from the same scene instance, ``distance`` =
-    (min, max) metres apart, with the oracle's waypoint for each."""
+    (min, max) metres apart and joined by a path for a disc of ``radius`` metres (the
+    task's ``path_radius``: the episodes' own rule), with the oracle's waypoint for each."""
     lo, hi = distance
     current, home, target = [], [], []
     bar = tqdm(total=n_pairs, desc="labelling pose pairs", disable=not progress)
@@ -151,10 +153,13 @@ def pair_set(bank: PoseBank, n_pairs: int, distance: tuple[float, float], oracle
         if len(candidates) == 0:
             continue
         i = int(rng.choice(candidates))
-        oracle.reset()
+        scene = bank.scenes[bank.scene_index[i]]
         pose = (*bank.positions[i], 0.0)
         home_pose = (*bank.positions[j], 0.0)
-        target.append(oracle.waypoint(bank.scenes[bank.scene_index[i]], pose, home_pose))
+        if not connected(scene, pose, home_pose, radius):
+            continue
+        oracle.reset()
+        target.append(oracle.waypoint(scene, pose, home_pose))
         current.append(i)
         home.append(j)
         bar.update()
@@ -283,8 +288,9 @@ def pretrain(model, env_id: str, env_kwargs: dict, positions: int, scenes: int,
     finally:
         for env in envs:
             env.close()
-    pairs = pair_set(bank, 8 * positions, distance, oracle, rng, progress)
-    check_pairs = pair_set(check, 2 * len(check.positions), distance, oracle, rng, progress)
+    pairs = pair_set(bank, 8 * positions, distance, oracle, rng, task.path_radius, progress)
+    check_pairs = pair_set(check, 2 * len(check.positions), distance, oracle, rng,
+                           task.path_radius, progress)
     if stop:
         pairs = joined(pairs, near_pairs(bank, oracle))
         check_pairs = joined(check_pairs, near_pairs(check, oracle))

@@ -530,3 +530,14 @@ def test_harness_passes_its_defaults_only_to_envs_that_take_them():
     assert env_parameters("homing_gym/LocalHoming-v0") is None
     assert harness_env_kwargs("homing_gym/LocalHoming-v0", {"scene": "lab"}, added) == {
         **added, "scene": "lab"}
+
+
+def test_field_grid_keeps_only_points_with_a_path_home():
+    from homing_gym.scenes.base import Scene, Wall
+
+    # 6 x 2 m split at x = 0 by a wall from bound to bound: the right room has no way home
+    scene = Scene("two_rooms", ((-3.0, -1.0), (3.0, 1.0)),
+                  walls=(Wall((0.0, -1.0), (0.0, 1.0), thickness=0.1),))
+    points = field_cli.grid_points(scene, (-1.5, 0.0, 0.0), 0.25, 0.22, 0.15, 0.22)
+    assert len(points) > 10
+    assert np.all(points[:, 0] < 0)

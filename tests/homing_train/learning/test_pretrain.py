@@ -53,7 +53,7 @@ def test_pair_labels_turn_towards_the_oracle_waypoint(env):
     helper = MotionHelper(oracle.motion_spec, oracle.motion)
     bank = render_bank(env, 12, 1, seed=3, progress=False)
     rng = np.random.default_rng(0)
-    pairs = pair_set(bank, 30, (0.15, 1.5), oracle, rng, progress=False)
+    pairs = pair_set(bank, 30, (0.15, 1.5), oracle, rng, 0.22, progress=False)
     d = np.linalg.norm(bank.positions[pairs.current] - bank.positions[pairs.home], axis=1)
     assert np.all((d >= 0.15) & (d <= 1.5))
     width = KWARGS["panorama_shape"][1]
@@ -173,7 +173,7 @@ def test_a_bank_over_a_list_of_scenes_labels_near_pairs_stop():
     with pytest.raises(ValueError, match="even number"):
         render_bank(envs[:1], 5, 1, seed=0, near=0.3, progress=False)
     rng = np.random.default_rng(1)
-    pairs = joined(pair_set(bank, 20, (0.15, 1.5), oracle, rng, progress=False),
+    pairs = joined(pair_set(bank, 20, (0.15, 1.5), oracle, rng, 0.22, progress=False),
                    near_pairs(bank, oracle))
     radius = STOP_SHARE * 0.15
     p = np.arange(len(pairs.current))
