@@ -116,18 +116,19 @@ def equal_time_kwargs(setting_kwargs: dict, recorded: dict, default_steps: int |
     that the policy keeps its own renderer and physics (:data:`POLICY_OWN`: what it was
     trained with, until it is retrained), and every row gets the same time: the
     setting's step cap, or where it sets none the env id's registered one
-    (``default_steps``; ``None``: no cap), counted at :data:`BASE_PERIOD`, becomes the
-    same time at the policy's control period. The cap the policy was trained with (in
-    ``recorded``) is never used: it would give a policy more or less time than the
-    controllers beside it."""
+    (``default_steps``; ``None``: no cap), counted at the setting's control period
+    (:data:`BASE_PERIOD` unless it sets one), becomes the same time at the period the
+    policy acts at. The cap the policy was trained with (in ``recorded``) is never used:
+    it would give a policy more or less time than the controllers beside it."""
     merged = {**{key: recorded[key] for key in POLICY_FORMAT if key in recorded},
               **setting_kwargs,
               **{key: recorded[key] for key in POLICY_OWN if key in recorded}}
     steps = setting_kwargs.get("max_episode_steps", default_steps)
     merged.pop("max_episode_steps", None)
     if steps is not None:
-        period = float(recorded.get("control_period", BASE_PERIOD))
-        merged["max_episode_steps"] = max(1, round(steps * BASE_PERIOD / period))
+        seconds = steps * float(setting_kwargs.get("control_period", BASE_PERIOD))
+        period = float(merged.get("control_period", BASE_PERIOD))
+        merged["max_episode_steps"] = max(1, round(seconds / period))
     return merged
 
 

@@ -85,11 +85,6 @@ def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: in
     if unknown:
         raise ValueError(f"unknown methods {unknown}; available: {candidates}")
     learned = sorted(set(chosen) & set(policies))
-    if "control_period" in env_kwargs and learned:
-        raise ValueError(f"env kwargs set control_period, but the learned rows {learned} act "
-                         f"at the period they were trained with (and get the same time: "
-                         f"max_episode_steps counts steps of {BASE_PERIOD} s); drop it or "
-                         f"leave them out with --methods")
     out.mkdir(parents=True, exist_ok=True)
     paths = []
     setting = {**env_kwargs, "success_on": success_on}   # one rule for every row

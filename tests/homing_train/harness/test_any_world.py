@@ -81,8 +81,6 @@ def test_a_learned_row_gets_the_suites_world_and_the_same_time(tmp_path):
     (["--env-kwargs", '{"success_on": "reach"}'], "--success-on"),
     (["--scene", "moon"], "unknown scene 'moon'"),
     (["--scene", "lab", "--env-kwargs", '{"scene": "arena"}'], "give the scene once"),
-    (["--env-kwargs", '{"control_period": 0.2}', "--methods", "oracle", "ppo_procedural"],
-     "learned rows ['ppo_procedural']"),
     (["--protocols", "yukim", "--scene", "lab"], "--protocols fix the envs"),
 ])
 def test_suite_refuses_bad_world_options_before_any_work(tmp_path, capsys, argv, message):

@@ -63,6 +63,13 @@ def test_a_policy_with_a_longer_control_period_gets_the_same_time():
     assert "max_episode_steps" not in equal_time_kwargs({"scene": "lab"}, recorded, None)
     same_period = equal_time_kwargs({"scene": "lab"}, {"max_episode_steps": 200}, 500)
     assert same_period["max_episode_steps"] == 500
+    # a setting's own period: its 100 steps of 0.2 s are 20 s for every row
+    slow = equal_time_kwargs({"scene": "lab", "control_period": 0.2, "max_episode_steps": 100},
+                             recorded, 500)
+    assert slow["control_period"] == 0.2 and slow["max_episode_steps"] == 100
+    fast = equal_time_kwargs({"scene": "lab", "control_period": 0.2, "max_episode_steps": 100},
+                             {"control_period": 0.1}, 500)
+    assert fast["control_period"] == 0.2 and fast["max_episode_steps"] == 100
 
 
 def test_a_policys_record_cannot_change_the_task():
