@@ -61,7 +61,9 @@ class Cell:
     """One method on one protocol: the summary over all its episodes (success under
     the stop rule, ``reached_rate``, SPL, ... with 95% CIs), per-setting success and
     episode counts, and the command that reproduces it; ``privileged``: what beyond
-    pixels the protocol gives and the policy trained on (its shipped ``.yml``)."""
+    pixels the protocol gives and the policy trained on (its shipped ``.yml``);
+    ``seed``: the base seed its episodes were drawn from, ``canonical_draw``: whether
+    that is the protocol's own (``homing-eval --protocol P --seed S`` draws others)."""
 
     protocol: str
     version: int
@@ -70,6 +72,8 @@ class Cell:
     summary: dict
     settings: dict
     privileged: str = ""
+    seed: int | None = None
+    canonical_draw: bool = True
 
 
 def shipped_for(env_ids: Sequence[str]) -> dict:
@@ -184,7 +188,8 @@ def run_cell(protocol: Protocol, method: str, out: Path, episodes: int | None = 
     cell = Cell(protocol=protocol.name, version=protocol.version, method=method,
                 command=protocol.command(method, episodes),
                 summary=summarize(records, radius=radius), settings=per_setting,
-                privileged="; ".join(p for p in (protocol.privileged, own) if p))
+                privileged="; ".join(p for p in (protocol.privileged, own) if p),
+                seed=protocol.seed, canonical_draw=protocol.canonical)
     (out / "cell.json").write_text(json.dumps(asdict(cell), indent=1))
     return cell
 
@@ -268,6 +273,7 @@ def matrix_markdown(cells: Sequence[Cell]) -> str:
     protocols = list(dict.fromkeys(c.protocol for c in cells))
     methods = list(dict.fromkeys(c.method for c in cells))
     by = {(c.protocol, c.method): c for c in cells}
+    redrawn = sorted({f"{c.protocol} (seed {c.seed})" for c in cells if not c.canonical_draw})
     privileged = {m: "; ".join(dict.fromkeys(
         p for p in [c.privileged for c in cells if c.method == m]
         + ([homing_baselines.controller_class(m).privileged]
@@ -276,7 +282,8 @@ def matrix_markdown(cells: Sequence[Cell]) -> str:
     lines = ["Success: the agent stopped within the success radius of the goal (0.15 m; "
              "0.10 m in shiraishi-house; in briggs-corridors: stopped in front of the goal "
              "landmark); % with 95% Wilson interval, episodes per cell in the second table.",
-             "",
+             *([f"Not the canonical draw of episodes: {', '.join(redrawn)}.", ""]
+               if redrawn else [""]),
              "| method | " + " | ".join(protocols) + " |",
              "|---|" + "---:|" * len(protocols)]
     for m in methods:

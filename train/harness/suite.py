@@ -146,9 +146,6 @@ def main(argv: list[str] | None = None) -> int:
         except ValueError as err:
             parser.exit(2, f"homing-suite: error: {err}\n")
         print(matrix_markdown(cells))
-        for p in chosen:
-            if not p.canonical:
-                print(f"Note: {p.label}.")
         print(f"wrote {args.out}/matrix.md, matrix.csv, matrix.json, matrix.png")
         return 0
     if args.episodes is None:

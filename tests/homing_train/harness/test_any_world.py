@@ -11,6 +11,7 @@ import pytest
 import homing_gym  # noqa: F401
 
 from homing_train.harness import demo, eval_command, field, suite
+from homing_train.harness.matrix import Cell, matrix_markdown
 from homing_train.harness.policies import shipped_policies
 from homing_train.harness.protocols import protocol
 
@@ -41,6 +42,10 @@ def test_eval_protocol_with_a_seed_records_that_it_is_not_the_canonical_draw(tmp
     (setting,) = [p for p in (tmp_path / "cell").glob("*.json") if p.name != "cell.json"]
     seeds = [e["seed"] for e in json.loads(setting.read_text())["episodes"]]
     assert seeds == [5, 1005, 2005, 3005]                      # canonical: 0, 1000, ...
+    table = matrix_markdown([Cell(**doc)])
+    assert "Not the canonical draw of episodes: yukim (seed 5)." in table
+    assert "canonical" not in matrix_markdown([Cell(**{**doc, "seed": 0,
+                                                       "canonical_draw": True})])
 
 
 def test_suite_env_kwargs_reach_every_row(tmp_path):
