@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 
 import numpy as np
@@ -235,7 +236,8 @@ class RouteFollowingEnv(HomingEnv):
     ``scene`` (default ``"hallway"``; any scene with ``metadata["route_origin"]``, or any
     scene with ``route``), ``n_targets`` = 17, ``spacing`` = 0.3048, ``route`` = ``None``
     (a sequence of at least two points ``(x, y)`` or ``(x, y, yaw)``, metres and radians
-    counter-clockwise from +x, e.g. ``[(1, 0), (2, 0.3), (3, 0)]``: the first is where the
+    counter-clockwise from +x, e.g. ``[(1, 0), (2, 0.3), (3, 0)]``, or the path of a
+    ``.csv``, ``.npy`` or ``.json`` file of such rows, at most 10,000: the first is where the
     robot starts, the others are the targets in order; a missing yaw is the direction of
     travel from the previous point; consecutive points at least 0.05 m apart, every point
     inside the scene with room for the robot's body, 0.16 m of clearance, and joined to
@@ -252,7 +254,8 @@ class RouteFollowingEnv(HomingEnv):
     """
 
     def __init__(self, scene: str | Scene = "hallway", *, n_targets: int = 17,
-                 spacing: float = FOOT, route: Sequence[Sequence[float]] | None = None,
+                 spacing: float = FOOT,
+                 route: Sequence[Sequence[float]] | str | os.PathLike | None = None,
                  start_jitter: tuple[float, float] = (0.05, 0.1745),
                  success_radius: float = 0.1, success_on: str = "reach",
                  reward: RewardConfig = RewardConfig(), **kwargs):
