@@ -28,6 +28,8 @@ COMMANDS = {
     "python -m homing_gym.envcard": "homing_gym.envcard",
     "python -m homing_gym.textures": "homing_gym.textures",
     "python -m homing_gym.scenes.mesh_example": "homing_gym.scenes.mesh_example",
+    "python -m homing_gym.scenes.tussocks": "homing_gym.scenes.tussocks",
+    "python -m homing_gym.freespace": "homing_gym.freespace",
 }
 
 

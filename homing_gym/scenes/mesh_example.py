@@ -11,6 +11,8 @@ own floor at z = 0. Each piece is a named node of the file (``north``, ``pillar`
 
 from __future__ import annotations
 
+import os
+
 import trimesh
 
 #: The pillar: x, y, radius (metres).
@@ -46,10 +48,11 @@ def example_room_parts() -> dict[str, trimesh.Trimesh]:
     return parts
 
 
-def write_example_room(path) -> None:
-    """Write the room to ``path``: a GLB (or glTF) keeps one node per piece; other formats
-    trimesh writes (OBJ, PLY, STL) get the pieces joined into one mesh."""
-    parts = example_room_parts()
+def write_parts(parts: dict[str, trimesh.Trimesh], path) -> None:
+    """Write named meshes to ``path``: a GLB (or glTF) keeps one node per piece; other
+    formats trimesh writes (OBJ, PLY, STL) get the pieces joined into one mesh. Missing
+    folders of ``path`` are made."""
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     if str(path).lower().endswith((".glb", ".gltf")):
         scene = trimesh.Scene()
         for name, mesh in parts.items():
@@ -57,6 +60,11 @@ def write_example_room(path) -> None:
         scene.export(path)
     else:
         trimesh.util.concatenate(list(parts.values())).export(path)
+
+
+def write_example_room(path) -> None:
+    """Write the room to ``path`` (:func:`write_parts`)."""
+    write_parts(example_room_parts(), path)
 
 
 def main(argv: list[str] | None = None) -> int:
