@@ -42,6 +42,7 @@ from tqdm import tqdm
 import homing_gym  # noqa: F401  (registers the envs)
 from homing_gym.cli import command_parser
 from homing_gym.scenes import Landmark, MeshScene, Scene, scene_factory, square_walls
+from homing_gym.scenes.tussocks import tussock_blades
 
 #: Panorama shapes measured, (H, W) pixels.
 SHAPES = {"48x256": (48, 256), "60x360": (60, 360), "120x720": (120, 720)}
@@ -92,36 +93,13 @@ def mesh_world(rocks: int = 30, seed: int = 0) -> MeshScene:
 
 def grass_world(blades: int = 10_000, seed: int = 0) -> MeshScene:
     """A 10 m square of tussock grass the robot drives through (no collision, fenced):
-    ``blades`` blades, one thin triangle each (1-4 cm wide at the ground, 5-90 cm tall,
-    leaning up to a fifth of their height outwards), in clumps of 10-60 of up to 15 cm
-    radius, on a brown floor."""
-    rng = np.random.default_rng(seed)
-    sizes = []
-    while sum(sizes) < blades:
-        sizes.append(int(rng.integers(10, 61)))
-    sizes[-1] -= sum(sizes) - blades
-    clump = np.repeat(np.arange(len(sizes)), sizes)
-    centre = rng.uniform(-4.9, 4.9, (len(sizes), 2))[clump]
-    tallest = rng.uniform(0.2, 0.9, len(sizes))[clump]
-    offset = rng.uniform(0, 0.15, blades)[:, None] * _unit(rng.uniform(0, 2 * np.pi, blades))
-    foot = centre + offset
-    width = rng.uniform(0.01, 0.04, blades)[:, None] * _unit(rng.uniform(0, 2 * np.pi, blades))
-    height = rng.uniform(0.05, 1.0, blades) * (tallest - 0.05) + 0.05
-    outwards = offset / np.maximum(np.linalg.norm(offset, axis=1, keepdims=True), 1e-9)
-    lean = rng.uniform(0, 0.2, blades)[:, None] * height[:, None] * outwards
-    zero = np.zeros((blades, 1))
-    vertices = np.stack([np.hstack([foot - width / 2, zero]), np.hstack([foot + width / 2, zero]),
-                         np.hstack([foot + lean, height[:, None]])], 1).reshape(-1, 3)
-    colors = np.column_stack([rng.uniform(0.2, 0.5, blades), rng.uniform(0.45, 0.8, blades),
-                              rng.uniform(0.1, 0.3, blades)])
-    return MeshScene.from_arrays(vertices, np.arange(3 * blades).reshape(-1, 3), colors,
-                                 collision=False, name=f"grass{blades // 1000}k",
+    ``blades`` blades (:func:`homing_gym.scenes.tussocks.tussock_blades`: one thin
+    triangle each, 1-4 cm wide at the ground, 5-90 cm tall, in clumps of 10-60 of up to
+    15 cm radius), on a brown floor."""
+    corners, colors = tussock_blades(blades, seed, 4.9)
+    return MeshScene.from_arrays(corners.reshape(-1, 3), np.arange(3 * blades).reshape(-1, 3),
+                                 colors, collision=False, name=f"grass{blades // 1000}k",
                                  bounds=((-5, -5), (5, 5)), ground_color=(0.45, 0.35, 0.2, 1.0))
-
-
-def _unit(angle: np.ndarray) -> np.ndarray:
-    """Unit vectors ``(n, 2)`` at the angles ``angle`` (radians)."""
-    return np.column_stack([np.cos(angle), np.sin(angle)])
 
 
 #: Worlds measured: scene kwargs.
