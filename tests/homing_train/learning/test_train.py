@@ -431,7 +431,7 @@ def test_imitation_fits_the_policy_to_the_oracle_labels(tmp_path):
     oracle = homing_baselines.make("oracle")
     prepare_policy(oracle, env)
     rng = np.random.default_rng(0)
-    obs, labels, before = collect(env, oracle, model, 1.0, 3, 100, rng)
+    obs, labels, before = collect(env, oracle, model, 1.0, 6, 100, rng)
     data = {k: np.asarray(v) for k, v in obs.items()}
     labels = np.asarray(labels)
     first = fit(model, data, labels, 1, 32, rng)
