@@ -10,7 +10,8 @@ plane, and intersects the segment with the rows' rays in closed form; the neares
 pixel wins (depth = horizontal distance, monotone along each ray). So every pixel's
 result is the exact intersection of its own ray with the mesh, the same as a general ray
 caster's (Embree: tested), at the cost of a rasteriser: triangles x the columns they
-span, plus the pixels they cover. Ties on an edge shared by two triangles go to either.
+span, plus the pixels they cover. Of two hits at the same distance (on an edge shared by
+two triangles) the lower triangle index wins.
 
 Most of a detailed world's triangles are small (a column or two wide, often between two
 rows), so the work per triangle and per triangle-column pair is what counts. It is done
@@ -20,11 +21,18 @@ widened interval (:func:`triangle_spans`); the pairs cut :data:`CHUNK` at a time
 segments that fall between two rows dropped (:func:`_cut_columns`); then the rows of
 each pair, in the triangles' order (:func:`_fill_rows`). Every shortcut only widens what
 is tested exactly, so the pixels are those of the plain search (tested).
+
+In a world dense with small triangles (:data:`CULL_DENSITY`: grass, clutter) most of them
+are hidden behind nearer ones. There the triangles are grouped in cells of the ground
+(:func:`triangle_grid`) and a panorama casts them front to back, skipping those that
+stand wholly below the rows already covered by something nearer in every column they
+span (:func:`_uncovered`): what it casts tracks what is visible more than what is there.
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -188,8 +196,8 @@ def _bearing_span(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray, 
 
 @njit(cache=True, error_model="numpy")
 def triangle_spans(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
-                   origin: np.ndarray, yaw: float, lo: np.ndarray, hi: np.ndarray,
-                   kind: np.ndarray) -> None:
+                   origin: np.ndarray, yaw: float, k0: int, k1: int, lo: np.ndarray,
+                   hi: np.ndarray, kind: np.ndarray) -> None:
     """Which triangles the camera can see, and over which bearings.
 
     ``corners (9, N)``: the triangles' corners coordinate by coordinate (``x0, y0, z0,
@@ -202,8 +210,9 @@ def triangle_spans(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
     ``[-pi, pi)``), widened by
     :data:`_ATAN_SLACK` beyond the error of the approximate arctangents, so that no
     column the triangle reaches is missed: the caster tests each column exactly.
-    Branch-free per triangle, so that the loop is vectorised."""
-    for t in range(corners.shape[1]):
+    Only the triangles ``k0 <= t < k1``. Branch-free per triangle, so that the loop is
+    vectorised."""
+    for t in range(k0, k1):
         lo[t], hi[t], kind[t] = _bearing_span(corners, normals, closed, t, origin[0],
                                               origin[1], origin[2], yaw)
 
@@ -272,43 +281,58 @@ def _cut_columns(n: int, p: np.ndarray, H: int, even_rows: bool, top_angle: floa
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _row_hit(ti: float, a0: float, h0: float, a1: float, h1: float, da: float, depth: float):
+def _row_hit(ti: float, a0: float, h0: float, a1: float, h1: float, da: float, depth: float,
+             t: int, held: int, ties: bool):
     """``(closer, u, dist)``: where the ray of elevation tangent ``ti`` meets the
-    segment from ``(a0, h0)`` to ``(a1, h1)`` (``u`` the fraction of the way), and whether
-    that is nearer than ``depth``; no branch."""
+    segment from ``(a0, h0)`` to ``(a1, h1)`` of triangle ``t`` (``u`` the fraction of
+    the way), and whether that beats the hit so far, triangle ``held`` at ``depth``:
+    nearer, or (with ``ties``) as near and of a lower index; no branch."""
     fa = h0 - ti * a0
     fb = h1 - ti * a1
     u = min(max(fa / (fa - fb), 0.0), 1.0)
     dist = a0 + u * da
-    return (dist < depth) & (fa != fb), u, dist
+    return ((dist < depth) | (ties & (dist == depth) & (t < held))) & (fa != fb), u, dist
 
 
-@njit(cache=True, error_model="numpy")
-def _rows(first: int, end: int, t: int, j: int, jr: int, tan_elev: np.ndarray, a0: float,
-          h0: float, a1: float, h1: float, da: float, hit: np.ndarray, depth: np.ndarray) -> bool:
-    """Rows ``first <= i < end`` of column ``j`` (tangents from column ``jr``) where
-    triangle ``t``'s segment is nearest so far take it; whether any did. No branch, and
-    unsigned indices (numba reads them without testing for negative ones): vectorised."""
-    wins = 0
-    ju, jru = np.uint64(j), np.uint64(jr)
-    for q in range(end - first):
-        i = np.uint64(first + q)
-        closer, _, dist = _row_hit(tan_elev[i, jru], a0, h0, a1, h1, da, depth[ju, i])
-        depth[ju, i] = dist if closer else depth[ju, i]
-        hit[i, ju] = t if closer else hit[i, ju]
-        wins += closer
-    return wins > 0
+def _rows_kernel(ties: bool):
+    """:func:`_rows` with or without ``ties`` (:func:`_row_hit`), compiled apart so that
+    neither pays for the other's test."""
+
+    @njit(cache=True, error_model="numpy")
+    def rows(first: int, end: int, t: int, j: int, jr: int, tan_elev: np.ndarray, a0: float,
+             h0: float, a1: float, h1: float, da: float, hit: np.ndarray,
+             depth: np.ndarray) -> bool:
+        """Rows ``first <= i < end`` of column ``j`` (tangents from column ``jr``) where
+        triangle ``t``'s segment beats the hit so far take it; whether any did. No
+        branch, and unsigned indices (numba reads them without testing for negative
+        ones): vectorised."""
+        wins = 0
+        ju, jru = np.uint64(j), np.uint64(jr)
+        for q in range(end - first):
+            i = np.uint64(first + q)
+            closer, _, dist = _row_hit(tan_elev[i, jru], a0, h0, a1, h1, da, depth[ju, i], t,
+                                       hit[i, ju], ties)
+            depth[ju, i] = dist if closer else depth[ju, i]
+            hit[i, ju] = t if closer else hit[i, ju]
+            wins += closer
+        return wins > 0
+
+    return rows
+
+
+_rows, _rows_by_index = _rows_kernel(False), _rows_kernel(True)
 
 
 @njit(cache=True, error_model="numpy")
 def _rows_weighted(first: int, end: int, t: int, j: int, jr: int, tan_elev: np.ndarray,
                    a0: float, h0: float, a1: float, h1: float, da: float, w0: float, w1: float,
                    w2: float, dw0: float, dw1: float, dw2: float, hit: np.ndarray,
-                   weights: np.ndarray, depth: np.ndarray) -> bool:
+                   weights: np.ndarray, depth: np.ndarray, ties: bool) -> bool:
     """:func:`_rows`, also writing the barycentric weights of the hits."""
     wins = False
     for i in range(first, end):
-        closer, u, dist = _row_hit(tan_elev[i, jr], a0, h0, a1, h1, da, depth[j, i])
+        closer, u, dist = _row_hit(tan_elev[i, jr], a0, h0, a1, h1, da, depth[j, i], t,
+                                   hit[i, j], ties)
         if closer:
             wins = True
             depth[j, i] = dist
@@ -320,16 +344,19 @@ def _rows_weighted(first: int, end: int, t: int, j: int, jr: int, tan_elev: np.n
 
 
 @njit(cache=True, error_model="numpy")
-def _fill_rows(n: int, triangle: np.ndarray, column: np.ndarray, cut: np.ndarray,
-               tan_elev: np.ndarray, even_rows: bool, weighted: np.ndarray, hit: np.ndarray,
-               weights: np.ndarray, depth: np.ndarray, listed: np.ndarray, drawn: np.ndarray,
-               m: int) -> int:
+def _fill_rows(n: int, triangle: np.ndarray, column: np.ndarray, level: np.ndarray,
+               cut: np.ndarray, tan_elev: np.ndarray, even_rows: bool, weighted: np.ndarray,
+               hit: np.ndarray, weights: np.ndarray, depth: np.ndarray, bound: np.ndarray,
+               ties: bool, listed: np.ndarray, drawn: np.ndarray, m: int) -> int:
     """The rows of the first ``n`` cut pairs (:func:`_cut_columns`): each ray of the
     column between the segment's ends hits it at a distance found in closed form; the
     nearest hit so far per pixel wins. With ``even_rows`` every column's rows are read
-    from the first column, so that the image's memory stays in the cache. Appends to
-    ``drawn[:m]`` the triangles not yet ``listed`` that win a pixel; returns the new
-    ``m``."""
+    from the first column, so that the image's memory stays in the cache. A pair of
+    ``level[k] >= 0`` lies beyond ``reach[level[k]]``: its rows from ``bound[level[k],
+    j]`` down are already covered by something nearer (:func:`_uncovered`), and
+    skipped. ``ties``: of two hits at the same distance the lower triangle index wins
+    (else the first cast). Appends to ``drawn[:m]`` the triangles not yet ``listed``
+    that win a pixel; returns the new ``m``."""
     H, C = tan_elev.shape[0], CHUNK
     for k in range(n):
         if cut[_OK * C + k] == 0.0:
@@ -354,11 +381,15 @@ def _fill_rows(n: int, triangle: np.ndarray, column: np.ndarray, cut: np.ndarray
             end -= 1
         while end < H and tan_elev[end, jr] >= lowest:
             end += 1
+        if level[k] >= 0:
+            end = min(end, bound[level[k], j])
         if with_weights:
             wins = _rows_weighted(first, end, t, j, jr, tan_elev, a0, h0, a1, h1, da, w0, w1,
-                                  w2, dw0, dw1, dw2, hit, weights, depth)
+                                  w2, dw0, dw1, dw2, hit, weights, depth, ties)
         else:
-            wins = _rows(first, end, t, j, jr, tan_elev, a0, h0, a1, h1, da, hit, depth)
+            wins = (_rows_by_index(first, end, t, j, jr, tan_elev, a0, h0, a1, h1, da, hit,
+                                   depth) if ties else
+                    _rows(first, end, t, j, jr, tan_elev, a0, h0, a1, h1, da, hit, depth))
         if wins and not listed[t]:
             listed[t] = True
             drawn[m] = t
@@ -366,40 +397,120 @@ def _fill_rows(n: int, triangle: np.ndarray, column: np.ndarray, cut: np.ndarray
     return m
 
 
+class Triangles(NamedTuple):
+    """The world's triangles as :func:`cast_columns` reads them (:func:`triangle_grid`):
+    ``corners (9, N)`` coordinate by coordinate (``x0, y0, z0, x1, ...``, metres),
+    ``normals (3, N)``, ``closed (N,)`` (a closed solid's face, its normal pointing
+    out), ``index (N,)`` each one's index in the world mesh (what the caster writes),
+    ``top (N,)`` its highest corner's height; ``reach (L,)`` the distances (metres) of
+    the occlusion levels (:func:`_uncovered`). For occlusion culling the triangles are
+    grouped by cell: ``start[0]:start[1]`` those that reach across more than a cell,
+    cell ``c``'s ``start[c + 1]:start[c + 2]`` (in the order of their tops), ``box (C,
+    4)`` the ``(xmin, ymin, xmax, ymax)`` of each cell's triangles; else they are in the
+    mesh's order, ``start = [0, N]`` and there are no cells."""
+
+    corners: np.ndarray
+    normals: np.ndarray
+    closed: np.ndarray
+    index: np.ndarray
+    top: np.ndarray
+    start: np.ndarray
+    box: np.ndarray
+    reach: np.ndarray
+
+
+#: Side (metres) of :func:`triangle_grid`'s cells, and the most cells along a side (a
+#: larger world gets larger cells).
+CELL, MAX_CELLS = 1.0, 64
+#: Triangles no wider than a cell per square metre (of the rectangle they span) from
+#: which the caster culls hidden ones: its tests skip more than half the
+#: triangle-column pairs of ``grass50k`` (500 per square metre), under a quarter in the
+#: 10,000-triangle worlds (100 to 130), where they cost more than they save.
+CULL_DENSITY = 250.0
+#: Cells nearer than this (metres) are not tested for occlusion; beyond it, the distances
+#: of the occlusion levels (:attr:`Triangles.reach`) grow by this factor per level.
+NEAR_CELLS, LEVEL_FACTOR = 1.0, 2 ** 0.25
+#: Relative margin by which an occlusion test widens heights and distances: far beyond
+#: the rounding of the caster's arithmetic (about 1e-15).
+_OCCLUSION_SLACK = 1e-9
+
+
+def triangle_grid(triangles: np.ndarray, normals: np.ndarray, closed: np.ndarray,
+                  cell: float = CELL, cull_density: float = CULL_DENSITY) -> Triangles:
+    """The :class:`Triangles` of a mesh's ``triangles (N, 3, 3)`` (float32 corners),
+    ``normals (N, 3)`` and ``closed (N,)``: each triangle no wider than a cell (``cell``
+    metres, or more in a world over :data:`MAX_CELLS` cells across) in the square cell
+    of its centre, the others first, where such triangles are at least
+    ``cull_density`` per square metre of the rectangle they span; else no cells."""
+    tris = np.asarray(triangles, np.float32)
+    low, high = tris[:, :, :2].min(1).astype(np.float64), tris[:, :, :2].max(1).astype(np.float64)
+    corner, size = low.min(0), high.max(0) - low.min(0)
+    side = max(cell, float(size.max()) / MAX_CELLS)
+    cells = np.maximum(np.ceil(size / side), 1).astype(np.int64)
+    large = (high - low).max(1) > side
+    ij = np.minimum(((low + high) / 2 - corner) // side, cells - 1).astype(np.int64)
+    key = np.where(large, -1, ij[:, 0] * cells[1] + ij[:, 1])
+    top = tris[:, :, 2].max(1).astype(np.float64)
+    order = np.arange(len(tris))
+    start, box = np.array([0, len(tris)], np.int64), np.zeros((0, 4))
+    spread = (high[~large].max(0) - low[~large].min(0)) if (~large).any() else np.zeros(2)
+    if (~large).sum() >= cull_density * max(float(spread[0] * spread[1]), side * side):
+        order = np.lexsort((top, key))              # the large ones (key -1) first
+        small = order[~large[order]]
+        first = np.flatnonzero(np.r_[True, key[small][1:] != key[small][:-1]])
+        start = np.r_[0, len(tris) - len(small) + first, len(tris)].astype(np.int64)
+        box = np.column_stack([np.minimum.reduceat(low[small], first),
+                               np.maximum.reduceat(high[small], first)])
+    levels = 1 + max(0, math.ceil(math.log(max(float(np.hypot(*size)) + 2 * side, NEAR_CELLS)
+                                           / NEAR_CELLS, LEVEL_FACTOR)))
+    return Triangles(np.ascontiguousarray(tris[order].reshape(-1, 9).T),
+                     np.ascontiguousarray(np.asarray(normals, np.float32)[order].T),
+                     np.asarray(closed, np.bool_)[order], order.astype(np.int64), top[order],
+                     start, box, NEAR_CELLS * LEVEL_FACTOR ** np.arange(levels))
+
+
 @njit(cache=True, error_model="numpy")
 def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
-                 origin: np.ndarray, yaw: float, beta: np.ndarray, tan_elev: np.ndarray,
-                 circle: bool, even_rows: bool, top_angle: np.ndarray,
+                 index: np.ndarray, top: np.ndarray, start: np.ndarray, box: np.ndarray,
+                 reach: np.ndarray, origin: np.ndarray, yaw: float, beta: np.ndarray,
+                 tan_elev: np.ndarray, circle: bool, even_rows: bool, top_angle: np.ndarray,
                  rows_per_radian: np.ndarray, weighted: np.ndarray, hit: np.ndarray,
                  weights: np.ndarray, depth: np.ndarray, drawn: np.ndarray) -> int:
     """Nearest triangle per pixel.
 
-    ``corners (9, N)``: the triangles' world corners coordinate by coordinate (``x0,
-    y0, z0, x1, ...``, metres); ``normals (3, N)`` their normals; ``closed (N,)``: the
-    triangle bounds a closed solid and its normal points out, so it is skipped when
-    turned away from the camera (hidden by the solid's near side whenever the camera is
-    outside the solid); ``origin (3,)`` the camera; ``yaw`` its heading (radians);
-    ``beta (W,)`` column bearings relative to the heading, strictly descending within
-    ``(-pi, pi]``; ``tan_elev (H, W)`` tangent of each pixel's ray elevation,
-    descending down each column; ``circle``, ``even_rows``, ``top_angle``,
+    ``corners`` to ``reach``: the world's triangles (the fields of :class:`Triangles`,
+    passed one by one: numba reads a tuple's type slowly); a closed solid's face is skipped
+    when turned away from the camera (hidden by the solid's near side whenever the
+    camera is outside the solid); ``origin (3,)`` the camera; ``yaw`` its heading
+    (radians); ``beta (W,)`` column bearings relative to the heading, strictly
+    descending within ``(-pi, pi]``; ``tan_elev (H, W)`` tangent of each pixel's ray
+    elevation, descending down each column; ``circle``, ``even_rows``, ``top_angle``,
     ``rows_per_radian``: their layout (:class:`homing_gym.raycast.Rays`; with columns
     once round the circle at even steps a span's columns are found by arithmetic, else
     by searching ``beta``; with rows even in elevation and the same in every column,
     segments that fall between two rows are dropped early). Writes ``hit (H, W)`` the
-    triangle index (``-1``: nothing) and ``weights (H, W, 3)`` the barycentric weights
-    of the hit where the triangle is ``weighted`` (``(N,)`` bool: the shader needs them,
-    for a texture or a shadow; elsewhere left as they were); ``depth (W, H)`` is scratch
-    (the nearest hit's horizontal distance so far, column by column like the loops
-    below), overwritten. Returns ``m`` and writes ``drawn[:m]`` (``drawn (N,)``): every
-    triangle that won a pixel at some point, once (a superset of those in ``hit``).
+    triangle's index in the world mesh (``-1``: nothing) and ``weights (H, W, 3)`` the
+    barycentric weights of the hit where the triangle is ``weighted`` (``(N,)`` bool,
+    by mesh index: the shader needs them, for a texture or a shadow; elsewhere left as
+    they were); ``depth (W, H)`` is scratch (the nearest hit's horizontal distance so
+    far, column by column like the loops below), overwritten. Returns ``m`` and writes
+    ``drawn[:m]`` (``drawn (N,)``): every triangle that won a pixel at some point, once
+    (a superset of those in ``hit``). Of two hits at the same distance the triangle
+    with the lower index wins, whatever order the triangles are cast in.
 
-    Three passes: the triangles' bearing spans, all at once (:func:`triangle_spans`);
-    the pairs of a triangle and a column in its span, cut :data:`CHUNK` at a time
-    (:func:`_cut_columns`); then their rows (:func:`_fill_rows`), in the order of the
-    triangles.
+    Per group of triangles, three passes: their bearing spans, all at once
+    (:func:`triangle_spans`); the pairs of a triangle and a column in its span, cut
+    :data:`CHUNK` at a time (:func:`_cut_columns`); then their rows (:func:`_fill_rows`).
+    Occlusion culling (a panorama, in a world with cells): the large triangles and the
+    cells within :data:`NEAR_CELLS` first, then the other cells by their distance (front
+    to back), skipping what is hidden below the rows already covered by something nearer
+    (:func:`_uncovered`): a cell's triangles that stand too low in all its columns
+    (:func:`_first_uncovered`), a triangle in a column where it does, and a pair's
+    covered rows (:func:`_fill_rows`). Every test is conservative: the pixels are those
+    of casting every triangle (tested).
     """
     H, W = tan_elev.shape
-    N = corners.shape[1]
+    N, C, L = corners.shape[1], box.shape[0], reach.shape[0]
     depth[:] = np.inf
     hit[:] = -1
     cos_b = np.cos(yaw + beta)
@@ -408,61 +519,190 @@ def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
     per_radian = (W - 1) / (beta[0] - beta[W - 1]) if W > 1 else 0.0
     step = 2 * math.pi / W
     ranges = np.empty((4, N), np.int32)          # (first, count) of up to two column runs
-    if circle:
-        _circle_columns(corners, normals, closed, origin, yaw, beta[0], step, W, ranges)
-    else:
-        lo, hi, kind = np.empty(N), np.empty(N), np.empty(N, np.int8)
-        triangle_spans(corners, normals, closed, origin, yaw, lo, hi, kind)
-        ranges[:] = 0
-        _searched_columns(lo, hi, kind, beta, per_radian, ranges)
+    M = 0 if circle else N                        # spans found by search
+    lo, hi, kind = np.empty(M), np.empty(M), np.empty(M, np.int8)
     p = np.empty(13 * CHUNK)
     triangle, column = np.empty(CHUNK, np.int64), np.empty(CHUNK, np.int64)
+    pair_level = np.empty(CHUNK, np.int64)
     cut = np.empty(15 * CHUNK)
-    # the triangles with columns, listed without a branch (a skip would be mispredicted)
     seen = np.empty(N, np.int64)
-    m = 0
-    for t in range(N):
-        seen[m] = t
-        m += ranges[1, t] > 0
-    n = shown = 0
     listed = np.zeros(N, np.bool_)
     ox, oy, oz = origin[0], origin[1], origin[2]
-    for t in seen[:m]:
-        x0, y0, z0 = corners[0, t] - ox, corners[1, t] - oy, corners[2, t] - oz
-        x1, y1, z1 = corners[3, t] - ox, corners[4, t] - oy, corners[5, t] - oz
-        x2, y2, z2 = corners[6, t] - ox, corners[7, t] - oy, corners[8, t] - oz
-        for r in range(0, 4, 2):
-            for jj in range(ranges[r, t], ranges[r, t] + ranges[r + 1, t]):
-                j = jj - W if jj >= W else jj
-                p[n], p[CHUNK + n], p[2 * CHUNK + n] = x0, y0, z0
-                p[3 * CHUNK + n], p[4 * CHUNK + n], p[5 * CHUNK + n] = x1, y1, z1
-                p[6 * CHUNK + n], p[7 * CHUNK + n], p[8 * CHUNK + n] = x2, y2, z2
-                p[_COS * CHUNK + n], p[_SIN * CHUNK + n] = cos_b[j], sin_b[j]
-                if not even_rows:
-                    p[_TOP_ANGLE * CHUNK + n] = top_angle[j]
-                    p[_ROWS_PER_RADIAN * CHUNK + n] = rows_per_radian[j]
-                triangle[n], column[n] = t, j
-                n += 1
-                if n == CHUNK:
-                    _cut_columns(n, p, H, even_rows, top_angle[0], rows_per_radian[0], cut)
-                    shown = _fill_rows(n, triangle, column, cut, tan_elev, even_rows, weighted,
-                                       hit, weights, depth, listed, drawn, shown)
-                    n = 0
+    cull = circle and even_rows and C > 0
+    level, near, far, by_level = _cells_by_level(box, reach, ox, oy, C if cull else 0)
+    bound = np.full((L if cull else 0, W), H, np.int64)   # covered rows (:func:`_uncovered`)
+    n = shown = 0
+    for q in range(-1, C if cull else 0):         # the large triangles, then the cells
+        lv, k1 = -1, N
+        if q < 0:
+            k0, k1 = (start[0], start[1]) if cull else (0, N)
+        else:
+            c = by_level[q]
+            lv, k0, k1 = level[c], start[c + 1], start[c + 2]
+            if lv >= 0:
+                k0 = _first_uncovered(c, box, start, top, ox, oy, oz, yaw, beta[0], step,
+                                      near[c], far[c], depth, tan_elev, reach, lv, bound)
+        if circle:
+            _circle_columns(corners, normals, closed, origin, yaw, beta[0], step, W, k0, k1,
+                            ranges)
+        else:
+            triangle_spans(corners, normals, closed, origin, yaw, k0, k1, lo, hi, kind)
+            _searched_columns(lo, hi, kind, beta, per_radian, k0, k1, ranges)
+        # the triangles with columns, listed without a branch (a skip is mispredicted)
+        m = 0
+        for e in range(k1 - k0):
+            u = np.uint64(k0 + e)         # unsigned: numba indexes without testing for < 0
+            seen[m] = u
+            m += ranges[1, u] > 0
+        for k in seen[:m]:
+            x0, y0, z0 = corners[0, k] - ox, corners[1, k] - oy, corners[2, k] - oz
+            x1, y1, z1 = corners[3, k] - ox, corners[4, k] - oy, corners[5, k] - oz
+            x2, y2, z2 = corners[6, k] - ox, corners[7, k] - oy, corners[8, k] - oz
+            # beyond the first level: the tangent above which its rays pass (widened)
+            tangent = np.inf
+            if lv >= 0:
+                tangent = _triangle_tangent(top[k] - oz, x0, y0, x1, y1, x2, y2)
+            for r in range(0, 4, 2):
+                for jj in range(ranges[r, k], ranges[r, k] + ranges[r + 1, k]):
+                    j = jj - W if jj >= W else jj
+                    if lv >= 0 and tangent < _uncovered(depth, tan_elev, reach, lv, j, bound):
+                        continue                  # its rows there are all covered
+                    p[n], p[CHUNK + n], p[2 * CHUNK + n] = x0, y0, z0
+                    p[3 * CHUNK + n], p[4 * CHUNK + n], p[5 * CHUNK + n] = x1, y1, z1
+                    p[6 * CHUNK + n], p[7 * CHUNK + n], p[8 * CHUNK + n] = x2, y2, z2
+                    p[_COS * CHUNK + n], p[_SIN * CHUNK + n] = cos_b[j], sin_b[j]
+                    if not even_rows:
+                        p[_TOP_ANGLE * CHUNK + n] = top_angle[j]
+                        p[_ROWS_PER_RADIAN * CHUNK + n] = rows_per_radian[j]
+                    triangle[n], column[n], pair_level[n] = index[k], j, lv
+                    n += 1
+                    if n == CHUNK:
+                        _cut_columns(n, p, H, even_rows, top_angle[0], rows_per_radian[0], cut)
+                        shown = _fill_rows(n, triangle, column, pair_level, cut, tan_elev,
+                                           even_rows, weighted, hit, weights, depth, bound,
+                                           C > 0, listed, drawn, shown)
+                        n = 0
     _cut_columns(n, p, H, even_rows, top_angle[0], rows_per_radian[0], cut)
-    return _fill_rows(n, triangle, column, cut, tan_elev, even_rows, weighted, hit, weights,
-                      depth, listed, drawn, shown)
+    return _fill_rows(n, triangle, column, pair_level, cut, tan_elev, even_rows, weighted, hit,
+                      weights, depth, bound, C > 0, listed, drawn, shown)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _box_distances(x0: float, y0: float, x1: float, y1: float):
+    """``(near, far)``: the horizontal distances from the origin to the nearest and the
+    farthest point of the box ``x0 <= x <= x1, y0 <= y <= y1``, a little widened."""
+    dx, dy = max(max(x0, -x1), 0.0), max(max(y0, -y1), 0.0)
+    fx, fy = max(-x0, x1), max(-y0, y1)
+    return (math.sqrt(dx * dx + dy * dy) * (1 - _OCCLUSION_SLACK),
+            math.sqrt(fx * fx + fy * fy) * (1 + _OCCLUSION_SLACK))
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _top_tangent(rise: float, near: float, far: float) -> float:
+    """An upper bound (a little widened) of the elevation tangent, from the origin, of
+    a point at most ``rise`` above it and ``near`` to ``far`` away horizontally
+    (``near > 0``)."""
+    tangent = rise / (near if rise > 0.0 else far)
+    return tangent + _OCCLUSION_SLACK * (1.0 + abs(tangent))
+
+
+@njit(cache=True, error_model="numpy")
+def _triangle_tangent(rise: float, x0: float, y0: float, x1: float, y1: float, x2: float,
+                      y2: float) -> float:
+    """:func:`_top_tangent` of a triangle with corners ``(x0, y0)``, ... (relative to the
+    camera) rising at most ``rise`` above the camera."""
+    near, far = _box_distances(min(min(x0, x1), x2), min(min(y0, y1), y2),
+                               max(max(x0, x1), x2), max(max(y0, y1), y2))
+    return _top_tangent(rise, near, far)
+
+
+@njit(cache=True, error_model="numpy")
+def _uncovered(depth: np.ndarray, tan: np.ndarray, reach: np.ndarray, lv: int, j: int,
+               bound: np.ndarray) -> float:
+    """The tangent of the lowest row of column ``j`` (``inf`` if none) below which
+    every row down to the image's bottom has a hit nearer than ``reach[lv]``:
+    ``bound[lv, j]``, the first such row, moved up past those covered since it was last
+    asked (depths only shrink)."""
+    r = bound[lv, j]
+    while r > 0 and depth[j, r - 1] < reach[lv]:
+        r -= 1
+    bound[lv, j] = r
+    return tan[r - 1, 0] if r > 0 else np.inf
+
+
+@njit(cache=True, error_model="numpy")
+def _cells_by_level(box: np.ndarray, reach: np.ndarray, ox: float, oy: float, C: int):
+    """``(level, near, far, by_level)`` of the first ``C`` cells seen from ``(ox, oy)``:
+    the occlusion level each is tested at (the last of :attr:`Triangles.reach` within
+    its distance; -1 within the first: not tested), lower and upper bounds of the
+    distance to its triangles (a little widened), and the cells in the order of their
+    levels."""
+    L = reach.shape[0]
+    level, near, far = np.empty(C, np.int64), np.empty(C), np.empty(C)
+    for c in range(C):
+        near[c], far[c] = _box_distances(box[c, 0] - ox, box[c, 1] - oy, box[c, 2] - ox,
+                                         box[c, 3] - oy)
+        lv = -1
+        if near[c] >= reach[0]:
+            lv = min(int(math.log(near[c] / reach[0]) / math.log(LEVEL_FACTOR)), L - 1)
+            while lv > 0 and reach[lv] > near[c]:
+                lv -= 1
+        level[c] = lv
+    first = np.zeros(L + 2, np.int64)          # counted, then placed: a counting sort
+    for c in range(C):
+        first[level[c] + 2] += 1
+    for lv in range(L + 1):
+        first[lv + 1] += first[lv]
+    by_level = np.empty(C, np.int64)
+    for c in range(C):
+        by_level[first[level[c] + 1]] = c
+        first[level[c] + 1] += 1
+    return level, near, far, by_level
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _first_uncovered(c: int, box: np.ndarray, start: np.ndarray, top: np.ndarray, ox: float,
+                     oy: float, oz: float, yaw: float, first: float, step: float, near: float,
+                     far: float, depth: np.ndarray, tan: np.ndarray, reach: np.ndarray,
+                     lv: int, bound: np.ndarray) -> int:
+    """The first triangle of cell ``c`` (its triangles in the order of their tops) that
+    might be seen from ``(ox, oy, oz)``: those before it stand wholly below the rows
+    covered nearer than ``reach[lv]`` (:func:`_uncovered`) in every column the cell
+    spans (``W`` once round the circle at bearings ``first - j * step``). ``near``,
+    ``far``: lower and upper bounds of the distance to any point of the cell."""
+    x0, y0, x1, y1 = box[c, 0] - ox, box[c, 1] - oy, box[c, 2] - ox, box[c, 3] - oy
+    # the bearings of the box's corners, relative to the first one's
+    d1 = _approx_atan2(x0 * y0 - y0 * x1, x0 * x1 + y0 * y0)
+    d2 = _approx_atan2(x0 * y1 - y0 * x1, x0 * x1 + y0 * y1)
+    d3 = _approx_atan2(x0 * y1 - y0 * x0, x0 * x0 + y0 * y1)
+    a0 = _approx_atan2(y0, x0) - yaw
+    a0 -= 2 * math.pi * np.floor((a0 + math.pi) * (0.5 / math.pi))
+    lo = a0 + min(min(d1, d2), min(d3, 0.0)) - _ATAN_SLACK
+    hi = a0 + max(max(d1, d2), max(d3, 0.0)) + _ATAN_SLACK
+    j0 = int(np.ceil((first - hi) / step - _INDEX_SLACK))
+    j1 = int(np.floor((first - lo) / step + _INDEX_SLACK)) + 1
+    W = depth.shape[0]
+    lowest = np.inf
+    for jj in range(j0, j1):
+        lowest = min(lowest, _uncovered(depth, tan, reach, lv, jj % W, bound))
+    k, end = start[c + 1], start[c + 2]
+    while k < end and _top_tangent(top[k] - oz, near, far) < lowest:
+        k += 1
+    return k
 
 
 @njit(cache=True, error_model="numpy")
 def _circle_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
                     origin: np.ndarray, yaw: float, first: float, step: float, W: int,
-                    ranges: np.ndarray) -> None:
-    """``ranges[:, t]``: the first column (in ``[0, W)``; the run may go past ``W - 1``
-    and wraps round to column 0) and the number of columns (at most ``W``) of each
-    triangle's span (:func:`triangle_spans`; 0 for those skipped), then ``(0, 0)``, for
-    ``W`` columns once round the circle at bearings ``first - j * step``; a little wider
-    than the span (each column is tested exactly). Branch-free: vectorised."""
-    for t in range(corners.shape[1]):
+                    k0: int, k1: int, ranges: np.ndarray) -> None:
+    """``ranges[:, t]`` for ``k0 <= t < k1``: the first column (in ``[0, W)``; the run
+    may go past ``W - 1`` and wraps round to column 0) and the number of columns (at
+    most ``W``) of each triangle's span (:func:`triangle_spans`; 0 for those skipped),
+    then ``(0, 0)``, for ``W`` columns once round the circle at bearings ``first - j *
+    step``; a little wider than the span (each column is tested exactly). Branch-free:
+    vectorised."""
+    for q in range(k1 - k0):
+        t = np.uint64(k0 + q)     # unsigned: numba indexes without testing for < 0
         lo, hi, kind = _bearing_span(corners, normals, closed, t, origin[0], origin[1],
                                      origin[2], yaw)
         j0 = np.ceil((first - hi) / step - _INDEX_SLACK)           # whole numbers, as floats
@@ -478,11 +718,13 @@ def _circle_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray
 
 @njit(cache=True, error_model="numpy")
 def _searched_columns(lo: np.ndarray, hi: np.ndarray, kind: np.ndarray, beta: np.ndarray,
-                      per_radian: float, ranges: np.ndarray) -> None:
-    """``ranges[:, t]``: ``(first, count)`` of up to two runs of the columns ``beta``
-    (any bearings, strictly descending) in each triangle's span, found by search."""
+                      per_radian: float, k0: int, k1: int, ranges: np.ndarray) -> None:
+    """``ranges[:, t]`` for ``k0 <= t < k1``: ``(first, count)`` of up to two runs of
+    the columns ``beta`` (any bearings, strictly descending) in each triangle's span,
+    found by search."""
     W = beta.shape[0]
-    for t in range(lo.shape[0]):
+    for t in range(k0, k1):
+        ranges[:, t] = 0
         if kind[t] == EVERYWHERE:
             ranges[0, t], ranges[1, t] = 0, W
             continue

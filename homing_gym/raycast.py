@@ -39,7 +39,7 @@ from typing import NamedTuple
 import cv2
 import numpy as np
 
-from homing_gym.column_cast import cast_columns, lit_colors, shade
+from homing_gym.column_cast import cast_columns, lit_colors, shade, triangle_grid
 from homing_gym.panorama import (DEFAULT_LIGHTING, CameraConfig, Lighting, column_bearing,
                                  photometric, row_elevation)
 from homing_gym.shadows import ShadowMap, shadow_map
@@ -182,10 +182,9 @@ class RayCaster:
         self._tris = mesh.triangles.astype(np.float64)
         self._normals = mesh.normals.astype(np.float64)
         self._closed = mesh.closed.astype(np.bool_)
-        #: The corners and normals coordinate by coordinate, for the caster's span pass,
-        #: in the mesh's float32 (exact: half the memory to read for every image).
-        self._corners = np.ascontiguousarray(mesh.triangles.reshape(-1, 9).T, np.float32)
-        self._normals_by_axis = np.ascontiguousarray(mesh.normals.T, np.float32)
+        #: The triangles as the caster reads them (in the mesh's float32: exact, and half
+        #: the memory to read for every image), grouped by cell where dense enough to cull.
+        self._triangles = triangle_grid(mesh.triangles, mesh.normals, mesh.closed)
         self._uvs = mesh.uvs.astype(np.float64)
         self._texture = mesh.texture.astype(np.int64)
         #: Triangles whose hits need barycentric weights (a texture; with shadows, all).
@@ -241,9 +240,8 @@ class RayCaster:
         hit, weights, depth = self._buffers(H, W)
         origin = np.array([x, y, camera_height])
         weighted = self._everywhere if self.shadows else self._textured
-        drawn = self._drawn[:cast_columns(self._corners, self._normals_by_axis, self._closed,
-                                          origin, yaw, *rays, weighted, hit, weights, depth,
-                                          self._drawn)]
+        drawn = self._drawn[:cast_columns(*self._triangles, origin, yaw, *rays, weighted, hit,
+                                          weights, depth, self._drawn)]
         image = np.empty((H // k, W // k, 3), np.uint8)
         light = lighting or DEFAULT_LIGHTING
         shadow = self._shadow_map(light) if self.shadows else _NO_SHADOWS

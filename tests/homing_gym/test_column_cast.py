@@ -8,8 +8,8 @@ import sys
 import numpy as np
 import pytest
 
-from homing_gym.benchmark import mesh_world
-from homing_gym.column_cast import _ATAN_SLACK, _approx_atan2, cast_columns
+from homing_gym.benchmark import grass_world, mesh_world
+from homing_gym.column_cast import CELL, _ATAN_SLACK, _approx_atan2, cast_columns, triangle_grid
 from homing_gym.raycast import camera_rays, panorama_rays, perspective_rays
 from homing_gym.worldmesh import world_mesh
 
@@ -25,18 +25,18 @@ def rocks():
     return mesh, poses
 
 
-def _cast(mesh, pose, rays, weighted=None):
+def _cast(mesh, pose, rays, weighted=None, triangles=None):
     x, y, yaw, height = pose
     H, W = rays.tan_elev.shape
     hit, weights = np.empty((H, W), np.int64), np.full((H, W, 3), np.nan)
     depth = np.empty((W, H))
     if weighted is None:
         weighted = np.ones(len(mesh.triangles), np.bool_)
+    if triangles is None:
+        triangles = triangle_grid(mesh.triangles, mesh.normals, mesh.closed)
     drawn = np.empty(len(mesh.triangles), np.int64)
-    shown = cast_columns(np.ascontiguousarray(mesh.triangles.reshape(-1, 9).T),
-                         np.ascontiguousarray(mesh.normals.T), mesh.closed,
-                         np.array([x, y, height]), yaw, *rays, weighted, hit, weights, depth,
-                         drawn)
+    shown = cast_columns(*triangles, np.array([x, y, height]), yaw, *rays, weighted, hit,
+                         weights, depth, drawn)
     return hit, weights, depth.T, drawn[:shown]
 
 
@@ -113,6 +113,52 @@ def test_the_drawn_triangles_are_listed_once_and_include_every_one_hit(rocks):
             assert set(np.unique(hit[hit >= 0])) <= set(drawn)
 
 
+@pytest.fixture(scope="module")
+def grass():
+    """Dense grass (3,000 blades on 3 x 3 m: the caster culls hidden ones there), one
+    blade across a cell boundary (its centre on it) and one standing on one, with the
+    triangles grouped for culling and in the mesh's order (every one cast)."""
+    mesh = world_mesh(grass_world(3000, seed=1))
+    tris = mesh.triangles.copy()
+    tris[:, :, :2] *= 0.3
+    x = tris[:, :, 0].min() + 2 * CELL                      # a boundary between cells
+    tris[-2] = [[x - 0.01, 0.2, 0.0], [x + 0.01, 0.2, 0.0], [x, 0.2, 0.6]]
+    tris[-1] = [[x, -0.3, 0.0], [x + 0.02, -0.3, 0.0], [x, -0.3, 0.7]]
+    mesh.triangles = tris
+    culled = triangle_grid(mesh.triangles, mesh.normals, mesh.closed)
+    every = triangle_grid(mesh.triangles, mesh.normals, mesh.closed, cull_density=np.inf)
+    assert len(culled.box) > 1 and len(every.box) == 0
+    return mesh, culled, every
+
+
+def test_culling_hidden_grass_changes_no_pixel(grass):
+    """Front to back, the caster skips the blades hidden behind nearer ones; the hits
+    and depths are those of casting every blade, at random poses (cameras inside the
+    grass, at its edge and outside it), and it did skip some."""
+    mesh, culled, every = grass
+    rays = panorama_rays((48, 256), math.radians(60), 2)
+    rng = np.random.default_rng(2)
+    poses = [(*rng.uniform(-2.0, 2.0, 2), rng.uniform(-math.pi, math.pi), h)
+             for h in (0.05, 0.3, 0.3, 0.3, 1.2, 3.0)]
+    poses += [(0.0, 0.0, 0.5, 0.3), (0.15, 0.06, -2.0, 0.2), (4.0, -3.0, 2.0, 0.3)]
+    fewer = 0
+    for pose in poses:
+        hit, _, depth, drawn = _cast(mesh, pose, rays, triangles=culled)
+        every_hit, _, every_depth, every_drawn = _cast(mesh, pose, rays, triangles=every)
+        assert np.array_equal(hit, every_hit) and np.array_equal(depth, every_depth)
+        fewer += len(drawn) < len(every_drawn)
+    assert fewer >= len(poses) // 2
+
+
+def test_a_pinhole_view_of_culled_grass_is_that_of_every_blade(grass):
+    """Views (columns by search) cast every blade, in the grid's order: the same hits."""
+    mesh, culled, every = grass
+    rays = perspective_rays(80, 60, 70.0)
+    for pose in [(0.0, 0.0, 0.5, 0.3), (0.6, -0.4, 2.5, 0.1)]:
+        assert np.array_equal(_cast(mesh, pose, rays, triangles=culled)[0],
+                              _cast(mesh, pose, rays, triangles=every)[0])
+
+
 @pytest.mark.parametrize("turns", [-3, -1, 1, 3])
 def test_any_heading_gives_the_picture_of_the_same_heading_within_one_turn(rocks, turns):
     """A heading a whole number of turns away is the same camera: the panorama (columns by
@@ -134,13 +180,13 @@ def test_any_heading_gives_the_picture_of_the_same_heading_within_one_turn(rocks
 _ODD_CAMERAS = """
 import sys
 import numpy as np
-from homing_gym.benchmark import mesh_world
+from homing_gym.benchmark import grass_world, mesh_world
 from homing_gym.panorama import CameraConfig, Lighting
 from homing_gym.raycast import RayCaster
 from homing_gym.scenes import scene_factory
 from homing_gym.worldmesh import world_mesh
 rng = np.random.default_rng(0)
-for scene in (mesh_world(), scene_factory("hallway").build(rng),
+for scene in (mesh_world(), grass_world(30000), scene_factory("hallway").build(rng),
               scene_factory("random_rooms").build(rng)):
     mesh = world_mesh(scene)
     (xmin, ymin), (xmax, ymax) = scene.bounds

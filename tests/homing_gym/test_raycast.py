@@ -154,7 +154,7 @@ def test_every_pixel_hits_what_embree_hits(scene):
     embree = pytest.importorskip("embreex.rtcore_scene")
     from embreex.mesh_construction import TriangleMesh
 
-    from homing_gym.column_cast import cast_columns
+    from homing_gym.column_cast import cast_columns, triangle_grid
     from homing_gym.raycast import panorama_rays, perspective_rays
     from homing_gym.scenes import scene_factory
     from homing_gym.scenes.base import clearance
@@ -177,9 +177,9 @@ def test_every_pixel_hits_what_embree_hits(scene):
             beta, tan = rays.beta, rays.tan_elev
             H, W = tan.shape
             hit, weights = np.empty((H, W), np.int64), np.empty((H, W, 3))
-            cast_columns(tris.reshape(-1, 9).T.copy(), mesh.normals.T.copy(), mesh.closed,
-                         origin, yaw, *rays, np.ones(len(tris), np.bool_), hit, weights,
-                         np.empty((W, H)), np.empty(len(tris), np.int64))
+            cast_columns(*triangle_grid(mesh.triangles, mesh.normals, mesh.closed), origin, yaw,
+                         *rays, np.ones(len(tris), np.bool_), hit, weights, np.empty((W, H)),
+                         np.empty(len(tris), np.int64))
             cos_e = 1 / np.sqrt(1 + tan ** 2)
             dirs = np.stack([cos_e * np.cos(yaw + beta), cos_e * np.sin(yaw + beta),
                              cos_e * tan], -1).reshape(-1, 3).astype(np.float32)
