@@ -281,22 +281,21 @@ def _cut_columns(n: int, p: np.ndarray, H: int, even_rows: bool, top_angle: floa
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _row_hit(ti: float, a0: float, h0: float, a1: float, h1: float, da: float, depth: float,
-             t: int, held: int, ties: bool):
-    """``(closer, u, dist)``: where the ray of elevation tangent ``ti`` meets the
-    segment from ``(a0, h0)`` to ``(a1, h1)`` of triangle ``t`` (``u`` the fraction of
-    the way), and whether that beats the hit so far, triangle ``held`` at ``depth``:
-    nearer, or (with ``ties``) as near and of a lower index; no branch."""
+def _row_hit(ti: float, a0: float, h0: float, a1: float, h1: float, da: float, depth: float):
+    """``(nearer, as_near, u, dist)``: where the ray of elevation tangent ``ti`` meets
+    the segment from ``(a0, h0)`` to ``(a1, h1)`` (``u`` the fraction of the way), and
+    whether that is nearer than ``depth``, or as near; no branch."""
     fa = h0 - ti * a0
     fb = h1 - ti * a1
     u = min(max(fa / (fa - fb), 0.0), 1.0)
     dist = a0 + u * da
-    return ((dist < depth) | (ties & (dist == depth) & (t < held))) & (fa != fb), u, dist
+    return (dist < depth) & (fa != fb), (dist == depth) & (fa != fb), u, dist
 
 
 def _rows_kernel(ties: bool):
-    """:func:`_rows` with or without ``ties`` (:func:`_row_hit`), compiled apart so that
-    neither pays for the other's test."""
+    """:func:`_rows` with or without ``ties`` (of two hits at the same distance the lower
+    triangle index wins, else the first), compiled apart so that neither pays for the
+    other's test."""
 
     @njit(cache=True, error_model="numpy")
     def rows(first: int, end: int, t: int, j: int, jr: int, tan_elev: np.ndarray, a0: float,
@@ -310,8 +309,10 @@ def _rows_kernel(ties: bool):
         ju, jru = np.uint64(j), np.uint64(jr)
         for q in range(end - first):
             i = np.uint64(first + q)
-            closer, _, dist = _row_hit(tan_elev[i, jru], a0, h0, a1, h1, da, depth[ju, i], t,
-                                       hit[i, ju], ties)
+            closer, as_near, _, dist = _row_hit(tan_elev[i, jru], a0, h0, a1, h1, da,
+                                                depth[ju, i])
+            if ties:              # a constant: numba drops the branch not taken
+                closer |= as_near & (t < hit[i, ju])
             depth[ju, i] = dist if closer else depth[ju, i]
             hit[i, ju] = t if closer else hit[i, ju]
             wins += closer
@@ -331,9 +332,8 @@ def _rows_weighted(first: int, end: int, t: int, j: int, jr: int, tan_elev: np.n
     """:func:`_rows`, also writing the barycentric weights of the hits."""
     wins = False
     for i in range(first, end):
-        closer, u, dist = _row_hit(tan_elev[i, jr], a0, h0, a1, h1, da, depth[j, i], t,
-                                   hit[i, j], ties)
-        if closer:
+        nearer, as_near, u, dist = _row_hit(tan_elev[i, jr], a0, h0, a1, h1, da, depth[j, i])
+        if nearer or (ties and as_near and t < hit[i, j]):
             wins = True
             depth[j, i] = dist
             hit[i, j] = t
