@@ -425,7 +425,7 @@ CELL, MAX_CELLS = 1.0, 64
 #: Triangles no wider than a cell per square metre (of the rectangle they span) from
 #: which the caster culls hidden ones: its tests skip more than half the
 #: triangle-column pairs of ``grass50k`` (500 per square metre), under a quarter in the
-#: 10,000-triangle worlds (100 to 130), where they cost more than they save.
+#: 10,000-triangle worlds (about 100), where they cost more than they save.
 CULL_DENSITY = 250.0
 #: Cells nearer than this (metres) are not tested for occlusion; beyond it, the distances
 #: of the occlusion levels (:attr:`Triangles.reach`) grow by this factor per level.
