@@ -28,8 +28,7 @@ import numpy as np
 from tqdm import tqdm
 
 import homing_gym
-from homing_gym.cli import add_env_arguments, parse_json_kwargs, seed_value  # noqa: F401
-# (parse_json_kwargs: homing_train.learning.saturation imports it from here)
+from homing_gym.cli import add_env_arguments, seed_value
 from homing_gym.validation import require_positive
 from homing_gym.env import simulation_settings
 from homing_gym.paths import NoPathError, path_length, shortest_path

@@ -22,8 +22,7 @@ from dataclasses import dataclass
 import gymnasium as gym
 import numpy as np
 
-from homing_gym.cli import command_parser, seed_value
-from homing_train.harness.evaluate import parse_json_kwargs
+from homing_gym.cli import command_parser, parse_json_kwargs, seed_value
 
 #: ``|tanh(x)|`` above this counts as saturated (the gradient ``1 - tanh^2`` below 0.02).
 SATURATED = 0.99
