@@ -5,6 +5,7 @@ new one, never a torn one."""
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import errno
 import fcntl
@@ -73,6 +74,26 @@ def checked_output_dir(path: str, option: str = "--out") -> str:
     if not _writable(existing):
         raise ValueError(f"{option} {path!r}: cannot write in {existing!r} (permission)")
     return full
+
+
+def _argument(check):
+    """An argparse ``type`` that runs ``check`` on the text and keeps the text, so a bad
+    output ends the command at parse time (exit status 2, one ``error:`` line), before
+    any work."""
+    def checked(text: str) -> str:
+        try:
+            check(text, "path")
+        except ValueError as err:
+            raise argparse.ArgumentTypeError(str(err)) from None
+        return text
+    checked.__name__ = check.__name__.removeprefix("checked_")   # argparse's name for it
+    return checked
+
+
+#: ``type=`` of an option that names an output file (:func:`checked_output_file`).
+output_file_argument = _argument(checked_output_file)
+#: ``type=`` of an option that names an output folder (:func:`checked_output_dir`).
+output_dir_argument = _argument(checked_output_dir)
 
 
 @contextlib.contextmanager

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 import sys
 from pathlib import Path
 
@@ -28,6 +27,18 @@ from homing_train.harness.evaluate import (DEFAULT_ENV, add_backend_arguments,
 from homing_train.harness.matrix import run_cell
 from homing_train.harness.policies import recorded_settings
 from homing_train.harness.protocols import PROTOCOLS, protocol
+from homing_train.outputs import (OutputLock, checked_output_dir, checked_output_file,
+                                  output_file_argument, write_text_atomic)
+
+
+def _settings_folder(out: str) -> Path:
+    """``--protocol``'s folder of the settings' results: ``--out`` without its extension
+    (``ValueError`` if it has none, or the folder cannot be written)."""
+    folder = os.path.splitext(out)[0]
+    if folder == out:                   # the cell's file and its settings' folder would clash
+        raise ValueError(f"--out {out!r} needs an extension with --protocol, e.g. "
+                         f"{out}.json: the settings' results go to the folder {out}/")
+    return Path(checked_output_dir(folder, "--out's settings folder"))
 
 
 def _protocol_cell(args) -> int:
@@ -38,14 +49,11 @@ def _protocol_cell(args) -> int:
     chosen = protocol(args.protocol)
     if args.seed is not None:
         chosen = chosen.reseeded(args.seed)
-    folder = Path(os.path.splitext(args.out)[0])
-    if folder == Path(args.out):        # the cell's file and its settings' folder would clash
-        raise ValueError(f"--out {args.out!r} needs an extension with --protocol, e.g. "
-                         f"{args.out}.json: the settings' results go to the folder {args.out}/")
+    folder = _settings_folder(args.out)
     cell = run_cell(chosen, args.policy, folder, args.episodes, args.workers,
                     progress=not args.quiet, resume=args.resume, backend=args.backend,
                     address=args.ray_address)
-    shutil.copyfile(folder / "cell.json", args.out)
+    write_text_atomic(args.out, (folder / "cell.json").read_text())
     s = cell.summary
     print(f"{args.policy} on {chosen.label}: {s['episodes']} episodes, success (stopped "
           f"within the radius) {100 * s['success_rate']:.1f}% "
@@ -66,31 +74,40 @@ def main(argv: list[str] | None = None) -> int:
                         "the protocol's)")
     parser.add_argument("--bin-width", type=float, default=0.3,
                         help="start-distance bin width (m) for success by distance")
-    parser.add_argument("--out", required=True,
+    parser.add_argument("--out", required=True, type=output_file_argument,
                         help="result JSON path (a .csv goes beside; each finished episode is "
                         "appended to NAME.episodes.jsonl as it ends)")
     parser.add_argument("--resume", action="store_true",
                         help="keep the episodes already in NAME.episodes.jsonl and run the rest")
     add_backend_arguments(parser)
     args = parser.parse_args(argv)
-    try:
-        for path in (args.out, stream_path(args.out)):
-            if os.path.isdir(path):
-                raise ValueError(f"--out {path!r} is a directory")
+    try:                                # every output checked, then locked, before work
         if args.protocol:
-            return _protocol_cell(args)
-        spec = policy_from_args(args)
-        result = evaluate(spec, args.env, 100 if args.episodes is None else args.episodes,
-                          args.seed or 0, env_kwargs_from_args(args), args.workers,
-                          bin_width=args.bin_width, progress=not args.quiet,
-                          stream=stream_path(args.out), resume=args.resume,
-                          backend=args.backend, address=args.ray_address)
+            _settings_folder(args.out)
+        else:
+            checked_output_file(stream_path(args.out), "--out's episode stream")
+        with OutputLock(args.out):
+            return _protocol_cell(args) if args.protocol else _seeded_episodes(args)
     except ValueError as err:
         parser.exit(2, f"homing-eval: error: {err}\n")
+    except OSError as err:              # e.g. the disk filled while writing the result
+        parser.exit(2, f"homing-eval: error: {err}\n")
     except KeyboardInterrupt:
-        parser.exit(130, f"homing-eval: interrupted; the finished episodes are in "
-                         f"{stream_path(args.out)}: the same command with --resume runs "
-                         f"the rest\n")
+        kept = (f"the settings' streams in {os.path.splitext(args.out)[0]}/" if args.protocol
+                else stream_path(args.out))
+        parser.exit(130, f"homing-eval: interrupted; the finished episodes are in {kept}: "
+                         f"the same command with --resume runs the rest\n")
+
+
+def _seeded_episodes(args) -> int:
+    """Without ``--protocol``: evaluate the method on the seeded episodes, write the
+    result and print its summary."""
+    spec = policy_from_args(args)
+    result = evaluate(spec, args.env, 100 if args.episodes is None else args.episodes,
+                      args.seed or 0, env_kwargs_from_args(args), args.workers,
+                      bin_width=args.bin_width, progress=not args.quiet,
+                      stream=stream_path(args.out), resume=args.resume,
+                      backend=args.backend, address=args.ray_address)
     result.save(args.out)
     if spec.kind == "sb3" and (recorded := recorded_settings(spec.source)).source:
         print(f"settings recorded in {recorded.source} (explicit --env-kwargs/--param "

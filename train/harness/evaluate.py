@@ -10,6 +10,7 @@ The ``homing-eval`` command is :mod:`homing_train.harness.eval_command`.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
 import dataclasses
 import inspect
@@ -29,7 +30,7 @@ from tqdm import tqdm
 
 import homing_gym
 from homing_gym.cli import add_env_arguments, seed_value
-from homing_gym.validation import require_positive
+from homing_gym.validation import is_real, require_number, require_positive
 from homing_gym.env import simulation_settings
 from homing_gym.paths import NoPathError, path_length, shortest_path
 from homing_gym.geometry import wrap_angle
@@ -39,6 +40,7 @@ from homing_train.harness import metrics
 from homing_train.harness.policies import (PolicySpec, parse_params, policy_spec,
                                            recorded_settings)
 from homing_train.harness.rollout import prepare_policy, rollout
+from homing_train.outputs import OutputLock, atomic_path, write_text_atomic
 
 SCHEMA = 1
 
@@ -78,6 +80,67 @@ class EpisodeRecord:
         (:func:`summarize` then uses ``min_distance``)."""
         return None if self.targets is None else self.targets_reached == self.targets
 
+    @classmethod
+    def from_doc(cls, doc: Any) -> "EpisodeRecord":
+        """The record of a JSON object (a stream line, an episode of a result JSON);
+        ``ValueError`` naming the first field that is missing, of the wrong type or
+        impossible (:data:`RECORD_RANGES`: NaN, a negative count or length, an SPL above
+        1, ...). Keys it does not know are ignored."""
+        if not isinstance(doc, dict):
+            raise ValueError(f"an episode record is a JSON object, got {doc!r:.80}")
+        fields = dataclasses.fields(cls)
+        missing = [f.name for f in fields if f.name not in doc
+                   and f.default is dataclasses.MISSING
+                   and f.default_factory is dataclasses.MISSING]
+        if missing:
+            raise ValueError(f"episode record lacks the fields {missing}")
+        values = {f.name: doc[f.name] for f in fields if f.name in doc}
+        for name, (low, high, integer) in RECORD_RANGES.items():
+            if name not in ROUTE_FIELDS or values.get(name) is not None:
+                values[name] = require_number(name, values.get(name), low, high,
+                                              integer=integer)
+        for name in ("success", "terminated", "truncated", "all_targets_within_radius"):
+            value = values.get(name)
+            if not (isinstance(value, bool) or (value is None and name in ROUTE_FIELDS)):
+                raise ValueError(f"{name} must be true or false, got {value!r:.80}")
+        for name, size in (("start_pose", 3), ("home_pose", 3), ("trajectory", None),
+                           ("target_errors", None)):
+            if values.get(name) is not None:
+                _check_numbers(name, values[name], size)
+        return cls(**values)
+
+
+#: :class:`EpisodeRecord`'s fields that are ``None`` off a route.
+ROUTE_FIELDS = ("targets", "target_errors", "targets_finished", "targets_reached",
+                "all_targets_within_radius")
+#: Ranges of :class:`EpisodeRecord`'s numbers: (low, high, integer).
+RECORD_RANGES: dict[str, tuple[float, float, bool]] = {
+    "seed": (0, math.inf, True), "start_distance": (0, math.inf, False),
+    "shortest_path": (0, math.inf, False), "steps": (0, math.inf, True),
+    "path_length": (0, math.inf, False), "final_distance": (0, math.inf, False),
+    "min_distance": (0, math.inf, False), "collisions": (0, math.inf, True),
+    "spl": (0, 1, False), "soft_spl": (0, 1, False),
+    "final_heading_error_deg": (0, 180, False), "wall_time": (0, math.inf, False),
+    "targets": (0, math.inf, True), "targets_finished": (0, math.inf, True),
+    "targets_reached": (0, math.inf, True)}
+
+
+def _check_numbers(name: str, value: Any, size: int | None) -> None:
+    """``ValueError`` unless ``value`` is a list of ``size`` finite numbers (``size``
+    ``None``: any number of them, or of lists of two: a trajectory's points; the
+    errors at targets must be >= 0)."""
+    if not isinstance(value, list) or (size is not None and len(value) != size):
+        raise ValueError(f"{name} must be a list of {size or 'any number of'} numbers, "
+                         f"got {value!r:.80}")
+    points = value if name == "trajectory" else [value]
+    for point in points:
+        if not (isinstance(point, list) and (name != "trajectory" or len(point) == 2)
+                and all(is_real(v) for v in point)) or (
+                name == "target_errors" and any(v < 0 for v in point)):
+            raise ValueError(f"{name} holds a value that is not a finite number"
+                             f"{' pair' if name == 'trajectory' else ''}"
+                             f"{' >= 0' if name == 'target_errors' else ''}: {point!r:.80}")
+
 
 @dataclass
 class EvalResult:
@@ -110,10 +173,9 @@ class EvalResult:
                 "episodes": [asdict(e) for e in self.episodes]}
 
     def save(self, path: str) -> None:
-        """Write the JSON document to ``path`` and the episode table to ``path`` .csv."""
-        os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-        with open(path, "w") as f:
-            json.dump(self.to_dict(), f, default=_json_default)
+        """Write the JSON document to ``path`` and the episode table to ``path`` .csv,
+        each atomically (an interrupted save leaves the old file or the new one)."""
+        write_text_atomic(path, json.dumps(self.to_dict(), default=_json_default))
         write_csv(self.episodes, os.path.splitext(path)[0] + ".csv")
 
     @classmethod
@@ -136,12 +198,21 @@ class EvalResult:
         missing = [k for k in ("policy", "env_id", "seed", "summary", "episodes") if k not in doc]
         if missing:
             raise ValueError(f"{path}: result JSON lacks {missing}")
-        names = {f.name for f in dataclasses.fields(EpisodeRecord)}
-        try:
-            episodes = [EpisodeRecord(**{k: v for k, v in e.items() if k in names})
-                        for e in doc["episodes"]]
-        except TypeError as err:
-            raise ValueError(f"{path}: malformed episode record ({err})") from None
+        if not isinstance(doc["episodes"], list) or not doc["episodes"]:
+            raise ValueError(f"{path}: the result holds no episodes (episodes: "
+                             f"{doc['episodes']!r:.40}), so it has nothing to report")
+        episodes = []
+        for i, e in enumerate(doc["episodes"]):
+            try:
+                episodes.append(EpisodeRecord.from_doc(e))
+            except ValueError as err:
+                raise ValueError(f"{path}: episode {i}: {err}") from None
+        summary = doc["summary"]
+        if not isinstance(summary, dict) or summary.get("episodes") != len(episodes):
+            raise ValueError(f"{path}: its summary (of "
+                             f"{summary.get('episodes') if isinstance(summary, dict) else None}"
+                             f" episodes) is not of its {len(episodes)} episodes: the file "
+                             f"was edited or mixed; rerun homing-eval")
         return cls(policy=doc["policy"], params=doc.get("params", {}), env_id=doc["env_id"],
                    env_kwargs=doc.get("env_kwargs", {}), seed=doc["seed"], episodes=episodes,
                    summary=doc["summary"])
@@ -158,7 +229,7 @@ def _json_default(obj: Any) -> Any:
 def write_csv(episodes: Sequence[EpisodeRecord], path: str) -> None:
     """One row per episode, every field but the trajectory."""
     names = [f.name for f in dataclasses.fields(EpisodeRecord) if f.name != "trajectory"]
-    with open(path, "w", newline="") as f:
+    with atomic_path(path) as tmp, open(tmp, "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=names)
         writer.writeheader()
         for e in episodes:
@@ -532,17 +603,19 @@ def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int =
                                       "env_id": env_id, "env_kwargs": env_kwargs,
                                       **({"tasks": tasks} if tasks is not None else {})},
                                      default=_json_default))
-    done = read_stream(stream, settings) if stream and resume else {}
-    todo = [t for t in (tasks or [(s, None, None) for s in seeds]) if t[0] not in done]
-    sink = open_stream(stream, settings, append=bool(done)) if stream else None
-    try:
-        fresh = run_episodes(spec, env_id, env_kwargs, todo, workers, progress,
-                             desc=f"{spec.label}",
-                             on_record=None if sink is None else sink.write_record,
-                             backend=backend, address=address)
-    finally:
-        if sink is not None:
-            sink.close()
+    # one writer per stream: a second run on it fails here, before its first episode
+    with OutputLock(stream) if stream else contextlib.nullcontext():
+        done = read_stream(stream, settings) if stream and resume else {}
+        todo = [t for t in (tasks or [(s, None, None) for s in seeds]) if t[0] not in done]
+        sink = open_stream(stream, settings, append=bool(done)) if stream else None
+        try:
+            fresh = run_episodes(spec, env_id, env_kwargs, todo, workers, progress,
+                                 desc=f"{spec.label}",
+                                 on_record=None if sink is None else sink.write_record,
+                                 backend=backend, address=address)
+        finally:
+            if sink is not None:
+                sink.close()
     records = {r.seed: r for r in fresh} | done
     return EvalResult(policy=spec.label, params=spec.resolved_params(), env_id=env_id,
                       env_kwargs=env_kwargs, seed=seed,
@@ -552,21 +625,23 @@ def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int =
 
 class _Stream:
     """An open JSON-lines file of finished episodes, flushed line by line. A new file
-    that got no episode (the run failed before its first one) is removed on close, so
-    that it cannot block a later ``--resume`` with other settings."""
+    gets its first line (the settings) atomically; appending to an old one first drops
+    its torn last line (an interrupted write). A new file that got no episode (the run
+    failed before its first one) is removed on close, so that it cannot block a later
+    ``--resume`` with other settings."""
 
     def __init__(self, path: str, settings: dict, append: bool):
         self.path, self.append, self.records = path, append, 0
-        self.file = open(path, "a" if append else "w")
-        if not append:
-            self._line(settings)
-
-    def _line(self, doc: dict) -> None:
-        self.file.write(json.dumps(doc, default=_json_default) + "\n")
-        self.file.flush()
+        if append:
+            with open(path, "rb+") as f:
+                f.truncate(f.read().rfind(b"\n") + 1)
+        else:
+            write_text_atomic(path, _json_line(settings))
+        self.file = open(path, "a")
 
     def write_record(self, record: EpisodeRecord) -> None:
-        self._line(asdict(record))
+        self.file.write(_json_line(asdict(record)))
+        self.file.flush()
         self.records += 1
 
     def close(self) -> None:
@@ -575,34 +650,57 @@ class _Stream:
             os.remove(self.path)
 
 
+def _json_line(doc: dict) -> str:
+    return json.dumps(doc, default=_json_default) + "\n"
+
+
 def open_stream(path: str, settings: dict, append: bool = False) -> _Stream:
     """Open the episode stream (``ValueError`` naming the path if it cannot be written)."""
     try:
-        os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
         return _Stream(path, settings, append)
     except OSError as err:
         raise ValueError(f"cannot write {path!r}: {err.strerror}") from None
 
 
 def read_stream(path: str, settings: dict) -> dict[int, EpisodeRecord]:
-    """The finished episodes of a stream written with the same ``settings``, by seed (none
-    if the file does not exist; a torn last line, from an interrupted write, is ignored)."""
+    """The finished episodes of a stream written with the same ``settings``, by seed
+    (none if the file does not exist or lacks a whole first line). Its last line, if
+    torn by an interrupted write, is ignored; anything else unsound is a ``ValueError``
+    naming the file and line: a first line of other settings, a line that is not JSON,
+    a record with a missing, mistyped or impossible field
+    (:meth:`EpisodeRecord.from_doc`), a seed twice with different content."""
     if not os.path.exists(path):
         return {}
-    with open(path) as f:
-        lines = f.read().splitlines()
-    docs = []
-    for line in lines:
+    try:
+        with open(path, "rb") as f:
+            lines = f.read().decode(errors="replace").split("\n")
+    except OSError as err:
+        raise ValueError(f"{path}: not a readable episode stream ({err})") from None
+    lines.pop()         # "" after the last newline, or a line torn by an interrupted write
+    done: dict[int, EpisodeRecord] = {}
+    first: dict[int, int] = {}
+    for number, line in enumerate(lines, 1):
+        where = f"{path} line {number}"
         try:
-            docs.append(json.loads(line))
+            doc = json.loads(line)
         except json.JSONDecodeError:
+            raise ValueError(f"{where}: not a JSON line (torn or edited), so the stream "
+                             f"cannot be resumed; run without --resume to start over") from None
+        if number == 1:
+            if doc != settings:
+                raise ValueError(f"{where}: {path} holds episodes of other settings "
+                                 f"({doc!r:.300}); cannot resume with {settings!r:.300}")
             continue
-    if not docs or docs[0] != settings:
-        raise ValueError(f"{path} holds episodes of other settings ({docs[0] if docs else None});"
-                         f" cannot resume with {settings}")
-    names = {f.name for f in dataclasses.fields(EpisodeRecord)}
-    return {int(d["seed"]): EpisodeRecord(**{k: v for k, v in d.items() if k in names})
-            for d in docs[1:]}
+        try:
+            record = EpisodeRecord.from_doc(doc)
+        except ValueError as err:
+            raise ValueError(f"{where}: {err}") from None
+        if record.seed in done and done[record.seed] != record:
+            raise ValueError(f"{where}: seed {record.seed} again with other content than "
+                             f"at line {first[record.seed]}; the stream mixes two runs")
+        done[record.seed] = record
+        first.setdefault(record.seed, number)
+    return done
 
 
 def stream_path(out: str) -> str:
