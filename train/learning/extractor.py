@@ -24,6 +24,8 @@ not saturate (see docs/training.md, "Saturated features").
 
 from __future__ import annotations
 
+import math
+
 import gymnasium as gym
 import torch
 from stable_baselines3.common.preprocessing import is_image_space
@@ -94,7 +96,7 @@ class PanoramaGoalExtractor(BaseFeaturesExtractor):
                 raise ValueError(f"observation {key!r} is not an image space: "
                                  f"{observation_space[key]}")
         extra_keys = [k for k in observation_space.spaces if k not in image_keys]
-        extra_dim = sum(int(torch.tensor(observation_space[k].shape).prod()) for k in extra_keys)
+        extra_dim = sum(math.prod(observation_space[k].shape) for k in extra_keys)
         super().__init__(observation_space, features_dim + extra_dim)
         self.image_keys = tuple(image_keys)
         self.extra_keys = tuple(extra_keys)
@@ -173,7 +175,7 @@ class AlignedBandExtractor(BaseFeaturesExtractor):
             raise ValueError(f"the encoder's strides must be 1 (one column per shift); got "
                              f"{encoder}")
         extra_keys = [k for k in observation_space.spaces if k not in image_keys]
-        extra_dim = sum(int(torch.tensor(observation_space[k].shape).prod()) for k in extra_keys)
+        extra_dim = sum(math.prod(observation_space[k].shape) for k in extra_keys)
         super().__init__(observation_space, features_dim + extra_dim)
         channels, rows, width = observation_space[image_keys[0]].shape
         self.image_keys = tuple(image_keys)
