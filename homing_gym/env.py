@@ -46,6 +46,9 @@ MIN_TIME_STEP, MAX_TIME_STEP = 1 / 2000, 1 / 60
 #: Observation keys the env core provides (tasks may add more): see
 #: :mod:`homing_gym.observations`.
 OBSERVATION_KEYS = (*CORE_KEYS, "goal_step")
+#: Most episodes in one procedural world (``episodes_per_world``): a bound for a counter,
+#: far beyond any training run's need of a fresh world.
+MAX_EPISODES_PER_WORLD = 10**9
 #: Physics sub-steps per control period by default (1/120 s at the default 0.1 s).
 PHYSICS_SUBSTEPS = 12
 #: Grid (metres) on which a new world is checked for room for the robot.
@@ -122,10 +125,7 @@ class HomingEnv(gym.Env):
         if control_period > MAX_CONTROL_PERIOD:
             raise ValueError(f"control_period must be at most {MAX_CONTROL_PERIOD} s, "
                              f"got {control_period!r}")
-        if not (isinstance(physics_substeps, (int, np.integer))
-                and 1 <= physics_substeps <= MAX_SUBSTEPS):
-            raise ValueError(f"physics_substeps must be an integer in [1, {MAX_SUBSTEPS}], "
-                             f"got {physics_substeps!r}")
+        require_number("physics_substeps", physics_substeps, 1, MAX_SUBSTEPS, integer=True)
         time_step = control_period / physics_substeps
         if not MIN_TIME_STEP <= time_step <= MAX_TIME_STEP:
             raise ValueError(
@@ -140,9 +140,8 @@ class HomingEnv(gym.Env):
         require_number("vfov_deg", vfov_deg, 10, 120, "degrees")
         panorama_shape = require_sequence("panorama_shape", panorama_shape, 2,
                                           "(H, W) integers")
-        if not (isinstance(episodes_per_world, (int, np.integer)) and episodes_per_world >= 1):
-            raise ValueError(f"episodes_per_world must be an integer >= 1, got "
-                             f"{episodes_per_world!r}")
+        require_number("episodes_per_world", episodes_per_world, 1, MAX_EPISODES_PER_WORLD,
+                       integer=True)
         table: dict[str, ObservationKey] = {**CORE_KEYS,
                                             "goal_step": goal_step_key(goal_step_length),
                                             **task.observation_keys()}
@@ -225,7 +224,7 @@ class HomingEnv(gym.Env):
         self._last_obs: dict[str, np.ndarray] = {}
         self._skip_images = False
         self.goal_index = 0
-        self._goal_views: list[dict[str, np.ndarray]] = []
+        self._goal_views: list[dict[str, np.ndarray] | None] = []
         self._goal_obs: dict[str, np.ndarray] = {}
         self._start_pose = np.zeros(3)
         self._task_context = TaskContext(
@@ -295,12 +294,15 @@ class HomingEnv(gym.Env):
         if self.goal_index + 1 >= len(self.episode.goals):
             raise RuntimeError("the episode has no further goal")
         self.goal_index += 1
+        if self._goal_views[self.goal_index] is None:      # see reset: taken when needed
+            self._goal_views[self.goal_index] = self._snapshot(self.goal_pose, move_robot=False)
         self._goal_obs = self._goal_views[self.goal_index]
 
-    def _snapshot_panorama(self, pose) -> np.ndarray:
-        """The panorama taken with the robot standing at ``pose`` under snapshot-time
-        lighting (the robot stays there)."""
-        self.sim.robot.set_pose(*pose)
+    def _snapshot_panorama(self, pose, move_robot: bool = True) -> np.ndarray:
+        """The panorama taken at ``pose`` under snapshot-time lighting, with the robot
+        standing there (it stays there) when ``move_robot``."""
+        if move_robot:
+            self.sim.robot.set_pose(*pose)
         return self.camera.render(self.sim.client, pose)
 
     def _place_robot(self, pose, clear_contacts: bool = False) -> None:
@@ -311,20 +313,22 @@ class HomingEnv(gym.Env):
         origin = self.episode.home if self.odometry_origin == "home" else self.pose
         self.odometry.reset(to_frame(origin, self.pose), self.sim.robot.encoders())
 
-    def _goal_sight(self, pose: np.ndarray) -> Sight:
+    def _goal_sight(self, pose: np.ndarray, move_robot: bool = True) -> Sight:
         """The snapshot of a goal: its panorama is taken now, with the robot standing at
-        ``pose``; ``panorama_ahead(d)`` renders ``d`` metres straight ahead of it."""
+        ``pose`` when ``move_robot``; ``panorama_ahead(d)`` renders ``d`` metres straight
+        ahead of it."""
         def ahead(d: float) -> np.ndarray:
             return self._snapshot_panorama(np.array(
-                [pose[0] + d * math.cos(pose[2]), pose[1] + d * math.sin(pose[2]), pose[2]]))
+                [pose[0] + d * math.cos(pose[2]), pose[1] + d * math.sin(pose[2]), pose[2]]),
+                move_robot)
 
-        panorama = self._snapshot_panorama(pose)
+        panorama = self._snapshot_panorama(pose, move_robot)
         return Sight(self.camera, lambda: panorama, ahead=ahead)
 
-    def _snapshot(self, pose: np.ndarray) -> dict[str, np.ndarray]:
+    def _snapshot(self, pose: np.ndarray, move_robot: bool = True) -> dict[str, np.ndarray]:
         """The goal observation keys of a snapshot taken at ``pose`` (``goal`` always:
         the ``rgb_array`` picture shows it)."""
-        sight = self._goal_sight(pose)
+        sight = self._goal_sight(pose, move_robot)
         views = {"goal": sight.panorama}
         views.update({k: entry.produce(sight) for k, entry in self._table.items()
                       if entry.goal and k != "goal"})
@@ -439,7 +443,12 @@ class HomingEnv(gym.Env):
         self.sim.reset_world(self.scene)
         self.episode = self._episode_with_options(
             self.task.sample_episode(self.scene, self.np_random), options or {})
-        self._goal_views = [self._snapshot(goal) for goal in self.episode.goals]
+        # the ray caster never sees the robot's body, so it takes the snapshot of each
+        # later goal (a route's targets) when that goal becomes current, without moving
+        # the robot: a route of thousands of targets resets at the cost of one
+        lazy = self.sim.caster is not None
+        self._goal_views = [None if k and lazy else self._snapshot(goal)
+                            for k, goal in enumerate(self.episode.goals)]
         self.goal_index = 0
         self._goal_obs = self._goal_views[0]
         self._lighting = (random_lighting(self.np_random, self.lighting_change)

@@ -97,7 +97,8 @@ class CameraConfig:
         if not (math.radians(10) <= self.vfov <= math.radians(120)):
             raise ValueError(f"vfov must lie in [10, 120] degrees (given in radians), got "
                              f"{self.vfov!r} rad = {math.degrees(self.vfov):.1f} deg")
-        if self.n_views not in (3, 4, 6, 8):
+        if not isinstance(self.n_views, (int, np.integer)) or isinstance(self.n_views, bool) \
+                or self.n_views not in (3, 4, 6, 8):
             raise ValueError(f"n_views must be one of (3, 4, 6, 8), got {self.n_views!r}")
         require_number("omni_size", self.omni_size, 16, 2048, "pixels", integer=True)
         if not (1 <= self.signature_rows <= shape[0] - 2):

@@ -78,14 +78,41 @@ def connected(scene: Scene, a, b, radius: float = BODY_RADIUS,
     ``a`` to ``b`` (metres), decided without searching it: the straight segment is free,
     or the grid nodes that ``a`` and ``b`` join (:data:`ATTACH`) touch one free region
     (:func:`regions`), or touch each other."""
-    if segment_free(scene, a, b, radius):
-        return True
-    labels = regions(scene, radius, resolution)
-    ends, k = _ends(scene, a, b, radius, resolution), _attach_cells(resolution)
-    if max(abs(ends[0][0] - ends[1][0]), abs(ends[0][1] - ends[1][1])) <= 2 * k + 1:
-        return True
-    near = [labels[_block(c, k + 1)] for c in ends]   # the attached nodes and their neighbours
-    return bool(np.intersect1d(near[0][near[0] > 0], near[1][near[1] > 0]).size)
+    return segment_free(scene, a, b, radius) or bool(
+        _grid_joined(scene, np.array([a[:2]]), np.array([b[:2]]), radius, resolution)[0])
+
+
+def joined_in_order(scene: Scene, points, radius: float = BODY_RADIUS,
+                    resolution: float = RESOLUTION) -> np.ndarray:
+    """Whether each of ``points`` ``(N, 2+)`` (metres; extra columns such as a yaw are
+    ignored) is joined to the next as :func:`connected` says: ``(N - 1,)`` bools, from one
+    labelling of the grid for all pairs, with segment checks only for the pairs the grid
+    does not join (a route of thousands of points is checked in milliseconds)."""
+    pts = np.asarray(points, dtype=np.float64)[:, :2]
+    joined = _grid_joined(scene, pts[:-1], pts[1:], radius, resolution)
+    for i in np.flatnonzero(~joined):
+        joined[i] = segment_free(scene, pts[i], pts[i + 1], radius)
+    return joined
+
+
+def _grid_joined(scene: Scene, a: np.ndarray, b: np.ndarray, radius: float,
+                 resolution: float) -> np.ndarray:
+    """For floor points ``a[i]`` and ``b[i]`` (``(M, 2)`` metres): whether the grid nodes
+    they join (:data:`ATTACH`) touch each other or one free region (:func:`regions`)."""
+    labels, k = regions(scene, radius, resolution), _attach_cells(resolution)
+    ends_a, ends_b = _nodes(scene, a, radius, resolution), _nodes(scene, b, radius, resolution)
+    near = np.max(np.abs(ends_a - ends_b), axis=1) <= 2 * k + 1
+    reach = np.arange(-(k + 1), k + 2)              # the attached nodes and their neighbours
+    padded = np.pad(labels, k + 1)                  # 0 (blocked) beyond the grid
+
+    def around(ends: np.ndarray) -> np.ndarray:
+        ix = ends[:, 0, None, None] + k + 1 + reach[None, :, None]
+        iy = ends[:, 1, None, None] + k + 1 + reach[None, None, :]
+        return padded[ix, iy].reshape(len(ends), -1)
+
+    la, lb = around(ends_a), around(ends_b)
+    shared = ((la[:, :, None] == lb[:, None, :]) & (la[:, :, None] > 0)).any(axis=(1, 2))
+    return near | shared
 
 
 def segment_free(scene: Scene, a, b, radius: float, step: float = 0.01) -> bool:
@@ -136,10 +163,15 @@ def shortest_path(scene: Scene, start, goal, radius: float = BODY_RADIUS,
 
 def _ends(scene: Scene, a, b, radius: float, resolution: float) -> list[tuple[int, int]]:
     """The grid nodes nearest to floor points ``a`` and ``b``."""
-    free, (x0, y0) = occupancy(scene, radius, resolution)
-    nx, ny = free.shape
-    return [(min(nx - 1, max(0, int(round((p[0] - x0) / resolution)))),
-             min(ny - 1, max(0, int(round((p[1] - y0) / resolution))))) for p in (a, b)]
+    nodes = _nodes(scene, np.array([a[:2], b[:2]], dtype=np.float64), radius, resolution)
+    return [(int(i), int(j)) for i, j in nodes]
+
+
+def _nodes(scene: Scene, points: np.ndarray, radius: float, resolution: float) -> np.ndarray:
+    """The grid nodes ``(M, 2)`` (indices) nearest to floor points ``(M, 2)`` (metres)."""
+    free, origin = occupancy(scene, radius, resolution)
+    nodes = np.rint((points - np.asarray(origin)) / resolution).astype(np.int64)
+    return np.clip(nodes, 0, np.array(free.shape) - 1)
 
 
 def _attach_cells(resolution: float) -> int:

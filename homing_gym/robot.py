@@ -30,9 +30,12 @@ import pybullet as p
 from pybullet_utils.bullet_client import BulletClient
 
 from homing_gym.geometry import wrap_angle
+from homing_gym.validation import require_number
 
 URDF_PATH = str(resources.files("homing_gym") / "assets" / "robot.urdf")
 DRIVES = ("differential", "synchro")
+#: Largest ``odometry_noise``: a standard deviation of 100 % of each wheel increment.
+MAX_ODOMETRY_NOISE = 1.0
 
 
 #: PyBullet's default top speed of a joint (rad/s, ``maxJointVelocity``): wheel motors
@@ -211,10 +214,9 @@ class WheelOdometry:
     """
 
     def __init__(self, config: RobotConfig, noise: float):
-        if not np.isfinite(noise) or noise < 0:
-            raise ValueError(f"odometry_noise must be a finite number >= 0, got {noise!r}")
         self.config = config
-        self.noise = noise
+        self.noise = require_number("odometry_noise", noise, 0, MAX_ODOMETRY_NOISE,
+                                    "(relative standard deviation of each wheel increment)")
         self.estimate = np.zeros(3)
         self._last_angles = np.zeros(2)
 

@@ -34,7 +34,8 @@ def require_number(name: str, value, low: float, high: float, unit: str = "", *,
         kind = "an integer" if integer else "a number"
         bracket = ")" if high_open else "]"
         of = f" {unit}" if unit else ""
-        raise ValueError(f"{name} must be {kind} in [{low:g}, {high:g}{bracket}{of}, "
+        shown = (lambda v: f"{int(v):,}") if integer else (lambda v: f"{v:g}")
+        raise ValueError(f"{name} must be {kind} in [{shown(low)}, {shown(high)}{bracket}{of}, "
                          f"got {value!r}")
     return int(value) if integer else float(value)
 

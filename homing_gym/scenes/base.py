@@ -122,6 +122,9 @@ HEIGHT_BAND = (0.02, 0.35)
 #: Largest side (metres) of a scene's ``bounds``: the start/home sampling and the oracle
 #: grid the free floor in 2-5 cm cells (100 m: 4 million cells at 5 cm).
 MAX_SIDE = 100.0
+#: Farthest a scene's ``bounds`` (and a mesh world's vertices) may lie from the origin
+#: along each axis (metres): beyond, the renderers' 32-bit floats lose millimetres.
+MAX_COORDINATE = 10_000.0
 
 
 @dataclass(frozen=True)
@@ -154,6 +157,10 @@ class Scene:
             raise ValueError(f"scene {self.name!r}: bounds must be finite, got {self.bounds!r}")
         if not (xmax > xmin and ymax > ymin):
             raise ValueError(f"scene {self.name!r}: empty bounds {self.bounds!r}")
+        if max(abs(v) for v in (xmin, ymin, xmax, ymax)) > MAX_COORDINATE:
+            raise ValueError(f"scene {self.name!r}: bounds {self.bounds!r} reach beyond "
+                             f"{MAX_COORDINATE:g} m from the origin; the free floor must lie "
+                             f"within it (check a mesh's offset and scale)")
         if max(xmax - xmin, ymax - ymin) > MAX_SIDE:
             raise ValueError(f"scene {self.name!r}: bounds {self.bounds!r} span more than "
                              f"{MAX_SIDE:g} m a side (the free floor is gridded in 2-5 cm "

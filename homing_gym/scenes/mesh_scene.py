@@ -48,7 +48,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from homing_gym.scenes.base import HEIGHT_BAND, Color, Scene
+from homing_gym.scenes.base import HEIGHT_BAND, MAX_COORDINATE, Color, Scene
 from homing_gym.scenes.footprint import band_triangles
 from homing_gym.scenes.mesh_part import MeshPart
 from homing_gym.validation import is_real, require_positive
@@ -219,10 +219,23 @@ class MeshScene(Scene):
             part, vertices=part.vertices @ transform[:3, :3].T + transform[:3, 3],
             collision=(part.collision and options.collision
                        and part.name not in options.no_collision)) for part in parts)
+        _check_placed_extent(parts, name)
         bounds = options.bounds or _footprint_bounds(parts, options.height_band, name)
         return cls(name=name, bounds=bounds, meshes=parts, fence=options.fence,
                    ground_plane=options.ground_plane, floor_color=options.ground_color,
                    sky_color=options.sky_color, height_band=options.height_band)
+
+
+def _check_placed_extent(parts: tuple[MeshPart, ...], name: str) -> None:
+    """``ValueError`` if a placed vertex lies farther than :data:`MAX_COORDINATE` metres
+    from the origin along any axis (far from the origin the renderers' 32-bit floats
+    blur the world into sky: check ``scale`` and ``offset``)."""
+    reach = max(float(np.max(np.abs(p.vertices))) for p in parts)
+    if not reach <= MAX_COORDINATE:
+        raise ValueError(f"mesh scene {name!r}: placed by scale and offset, it reaches "
+                         f"{reach:.3g} m from the origin; every vertex must lie within "
+                         f"{MAX_COORDINATE:g} m of it along each axis: check scale and "
+                         f"offset")
 
 
 def _mesh_file(path: str) -> None:
@@ -411,8 +424,10 @@ def parse_mesh_spec(spec: str) -> tuple[str, MeshOptions]:
         for field in query.split("&") if query else ():
             key, equals, text = field.partition("=")
             if not key:
-                what = f"option {field!r} has no name" if field else "empty option"
-                raise ValueError(f"{what}: write options as key=value joined by '&', "
+                what = (f"option {field!r} has no name" if field else
+                        "an empty option (nothing between '?' or '&' and the next '&' or "
+                        "the end)")
+                raise ValueError(f"{what}: write mesh:PATH?option=value&option=value, "
                                  f"e.g. mesh:PATH?scale=0.01&up=y")
             _check_option_name(key)
             if not equals:

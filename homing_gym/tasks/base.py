@@ -16,9 +16,10 @@ import numpy as np
 
 from homing_gym.observations import ObservationKey
 from homing_gym.paths import BODY_RADIUS, RESOLUTION, occupancy
-from homing_gym.scenes.base import Scene, clearance
+from homing_gym.scenes.base import MAX_SIDE, Scene, clearance
 from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.episode import Episode
+from homing_gym.validation import is_real, require_sequence
 
 
 class Task(ABC):
@@ -83,6 +84,30 @@ def check_start_jitter(scene: Scene, point, jitter: float, margin: float, what: 
                          f"{point[1]:.2f}) of scene {scene.name!r} could start the robot "
                          f"within {margin} m of a wall or object ({free:.2f} m free there); "
                          f"at most {fits:.3f} m fits")
+
+
+def checked_start_jitter(value) -> tuple[float, float]:
+    """``start_jitter`` as ``(metres, radians)`` floats if it is two numbers, the first
+    in ``[0, MAX_SIDE]`` (the scene then bounds it: :func:`check_start_jitter`), the
+    second in ``[0, pi]``; else ``ValueError`` naming the value and the ranges."""
+    what = (f"(metres, radians): two numbers, metres in [0, {MAX_SIDE:g}] and radians "
+            f"in [0, pi]")
+    metres, radians = require_sequence("start_jitter", value, 2, what)
+    if not (is_real(metres) and is_real(radians) and 0 <= metres <= MAX_SIDE
+            and 0 <= radians <= math.pi):
+        raise ValueError(f"start_jitter must be {what}, got {value!r}")
+    return float(metres), float(radians)
+
+
+def check_start_off_goal(start, goal, success_radius: float, what: str) -> None:
+    """``ValueError`` unless the floor point ``start`` lies farther than
+    ``success_radius`` metres from ``goal``: an episode must not begin at its goal.
+    ``what`` names the two points in the message."""
+    gap = math.dist(start[:2], goal[:2])
+    if gap <= success_radius:
+        raise ValueError(f"success_radius {success_radius!r} m: {what} are {gap:.3f} m "
+                         f"apart, so an episode would begin at its goal; give a "
+                         f"success_radius below {gap:.3f} m")
 
 
 #: Draws over the scene bounds before :func:`sample_free_pose` draws over free cells.

@@ -7,10 +7,24 @@ from dataclasses import dataclass, fields
 
 from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.base import Task
-from homing_gym.validation import is_real, require_positive
+from homing_gym.validation import is_real
 
 
 SUCCESS_MODES = ("reach", "stop")
+#: Largest ``success_radius`` (m) any task takes: a goal judged from farther is no longer
+#: homing (the papers' radii are 0.1-0.3 m). Tasks also refuse a radius that an episode
+#: could start within (``check_scene``).
+MAX_SUCCESS_RADIUS = 2.0
+
+
+def checked_success_radius(value) -> float:
+    """``success_radius`` (metres) as a float if it is a number in
+    ``(0, MAX_SUCCESS_RADIUS]``; else ``ValueError`` naming the value and the range."""
+    if not (is_real(value) and 0 < value <= MAX_SUCCESS_RADIUS):
+        raise ValueError(f"success_radius must be a number of metres in "
+                         f"(0, {MAX_SUCCESS_RADIUS:g}] (a goal judged from farther is no "
+                         f"longer homing), got {value!r}")
+    return float(value)
 
 
 @dataclass(frozen=True)
@@ -67,10 +81,9 @@ class GoalReachingTask(Task):
 
     def __init__(self, success_radius: float = 0.15, success_on: str = "reach",
                  reward: RewardConfig | Mapping[str, float] = RewardConfig()):
-        require_positive("success_radius", success_radius, "metres")
+        self.success_radius = checked_success_radius(success_radius)
         if success_on not in SUCCESS_MODES:
             raise ValueError(f"unknown success_on {success_on!r}; allowed: {SUCCESS_MODES}")
-        self.success_radius = float(success_radius)
         self.success_on = success_on
         self.reward = RewardConfig.from_value(reward)
         self.goal_errors: list[float] = []

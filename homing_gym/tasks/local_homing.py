@@ -9,8 +9,8 @@ import numpy as np
 from homing_gym.paths import connected
 from homing_gym.scenes.base import Scene, clearance
 from homing_gym.tasks.base import Episode, sample_free_pose
-from homing_gym.tasks.goal_reaching import GoalReachingTask, RewardConfig
-from homing_gym.validation import require_positive
+from homing_gym.tasks.goal_reaching import (GoalReachingTask, RewardConfig,
+                                            checked_success_radius)
 
 
 class LocalHomingTask(GoalReachingTask):
@@ -32,8 +32,8 @@ class LocalHomingTask(GoalReachingTask):
         home, min at least the success radius; ``success_radius`` (metres, optional)
         replaces that radius at the same time (a curriculum that narrows it). A bad value
         raises ``ValueError`` and leaves both as they were."""
-        radius = self.success_radius if success_radius is None else success_radius
-        require_positive("success_radius", radius, "metres")
+        radius = checked_success_radius(self.success_radius if success_radius is None
+                                        else success_radius)
         lo, hi = (start_distance if np.ndim(start_distance) == 1 and len(start_distance) == 2
                   else (math.nan, math.nan))
         if not (math.isfinite(lo) and math.isfinite(hi) and 0 <= lo <= hi):

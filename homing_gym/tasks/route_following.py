@@ -7,18 +7,20 @@ from __future__ import annotations
 import math
 import numbers
 import os
+import reprlib
 from collections.abc import Sequence
 
 import numpy as np
 
 from homing_gym.geometry import FOOT, wrap_angle
-from homing_gym.paths import BODY_RADIUS, connected
-from homing_gym.scenes.base import Scene, clearance
+from homing_gym.paths import BODY_RADIUS, joined_in_order
+from homing_gym.scenes.base import MAX_SIDE, Scene, clearances
 from homing_gym.tasks.context import TaskContext
-from homing_gym.tasks.base import Episode, check_start_jitter
+from homing_gym.tasks.base import (Episode, check_start_jitter, check_start_off_goal,
+                                   checked_start_jitter)
 from homing_gym.tasks.goal_reaching import GoalReachingTask, RewardConfig
-from homing_gym.tasks.route_file import load_route
-from homing_gym.validation import require_positive
+from homing_gym.tasks.route_file import MAX_ROUTE_POINTS, load_route
+from homing_gym.validation import require_number
 
 #: The straight route's defaults: Hong et al.'s 17 targets 1 ft apart.
 N_TARGETS, SPACING = 17, FOOT
@@ -52,15 +54,18 @@ def route_poses(route: Sequence[Sequence[float]]) -> np.ndarray:
     ``MIN_ROUTE_STEP`` metres apart."""
     if not _is_sequence(route) or len(route) < 2:
         raise ValueError(f"route must be a sequence of at least two points (x, y) or "
-                         f"(x, y, yaw), got {route!r}")
+                         f"(x, y, yaw), got {reprlib.repr(route)}")
+    if len(route) > MAX_ROUTE_POINTS:
+        raise ValueError(f"route holds {len(route)} points; at most {MAX_ROUTE_POINTS} "
+                         f"(the start and the targets), as a route file")
     points = [_route_point(k, p) for k, p in enumerate(route)]
     xy = np.array([p[:2] for p in points])
     dx, dy = np.diff(xy, axis=0).T
-    for k, step in enumerate(np.hypot(dx, dy), start=1):
-        if step < MIN_ROUTE_STEP:
-            raise ValueError(f"route points {k - 1} {points[k - 1]} and {k} {points[k]} are "
-                             f"{step:.3f} m apart; consecutive points must be at least "
-                             f"{MIN_ROUTE_STEP} m apart")
+    steps = np.hypot(dx, dy)
+    for k in np.flatnonzero(steps < MIN_ROUTE_STEP)[:1] + 1:
+        raise ValueError(f"route points {k - 1} {points[k - 1]} and {k} {points[k]} are "
+                         f"{steps[k - 1]:.3f} m apart; consecutive points must be at least "
+                         f"{MIN_ROUTE_STEP} m apart")
     travel = np.arctan2(dy, dx)
     travel = np.concatenate([travel[:1], travel])
     yaws = [wrap_angle(p[2]) if len(p) == 3 else a for p, a in zip(points, travel)]
@@ -87,11 +92,11 @@ class RouteFollowingTask(GoalReachingTask):
                  reward: RewardConfig = RewardConfig(), clearance_margin: float = 0.18,
                  route: Sequence[Sequence[float]] | str | os.PathLike | None = None):
         route = load_route(route)                       # a path: the points of its file
-        if not (isinstance(n_targets, (int, np.integer)) and n_targets >= 1):
-            raise ValueError(f"n_targets must be an integer >= 1, got {n_targets!r}")
-        require_positive("spacing", spacing, "metres")
-        if len(start_jitter) != 2 or not all(math.isfinite(v) and v >= 0 for v in start_jitter):
-            raise ValueError(f"start_jitter must be (metres, radians) >= 0, got {start_jitter!r}")
+        require_number("n_targets", n_targets, 1, MAX_ROUTE_POINTS - 1, "(a route holds at "
+                       f"most {MAX_ROUTE_POINTS} points with its start)", integer=True)
+        require_number("spacing", spacing, MIN_ROUTE_STEP, MAX_SIDE, "metres (the least "
+                       "step of a route; the largest side of a scene)")
+        start_jitter = checked_start_jitter(start_jitter)
         if route is not None and (n_targets != N_TARGETS or spacing != SPACING):
             raise ValueError(f"n_targets ({n_targets!r}) and spacing ({spacing!r}) describe the "
                              f"straight route; with a route given they must keep their "
@@ -100,17 +105,17 @@ class RouteFollowingTask(GoalReachingTask):
         self.route = None if route is None else route_poses(route)
         self.n_targets = int(n_targets) if route is None else len(self.route) - 1
         self.spacing = float(spacing)
-        self.start_jitter = (float(start_jitter[0]), float(start_jitter[1]))
+        self.start_jitter = start_jitter
         self.clearance_margin = clearance_margin
 
-    def _route(self, scene: Scene) -> list[np.ndarray]:
-        """The start point, then the targets."""
+    def _route(self, scene: Scene) -> np.ndarray:
+        """The start point, then the targets: poses ``(n_targets + 1, 3)``."""
         if self.route is not None:
-            return [pose.copy() for pose in self.route]
+            return self.route.copy()
         x0, y0, yaw = scene.metadata["route_origin"]
-        c, s = math.cos(yaw), math.sin(yaw)
-        return [np.array([x0 + k * self.spacing * c, y0 + k * self.spacing * s, yaw])
-                for k in range(-1, self.n_targets)]
+        k = np.arange(-1, self.n_targets)
+        return np.column_stack([x0 + k * self.spacing * math.cos(yaw),
+                                y0 + k * self.spacing * math.sin(yaw), np.full(len(k), yaw)])
 
     @property
     def path_radius(self) -> float:
@@ -125,36 +130,64 @@ class RouteFollowingTask(GoalReachingTask):
         if self.route is None and "route_origin" not in scene.metadata:
             raise ValueError(f"scene {scene.name!r} defines no route (metadata['route_origin']); "
                              f"use a scene with one, e.g. 'hallway', or give route=[...]")
+        if self.route is None:
+            self._check_straight_fit(scene)
         points, radius = self._route(scene), self.path_radius
-        for k, pose in enumerate(points):
-            if self.route is not None:
-                self._check_route_point(scene, k, pose)
-            elif clearance(scene, (pose[0], pose[1])) < radius:
-                raise ValueError(
-                    f"{self.n_targets} targets {self.spacing} m apart do not fit along "
-                    f"the route of scene {scene.name!r}: ({pose[0]:.2f}, {pose[1]:.2f}) "
-                    f"is blocked")
-        for k in range(1, len(points)):
+        free = np.maximum(clearances(scene, points[:, :2]), 0.0)   # all points at once
+        if self.route is not None:
+            self._check_route_points(scene, points, free)
+        for k in np.flatnonzero(free < radius)[:1]:
+            raise ValueError(
+                f"{self.n_targets} targets {self.spacing} m apart do not fit along "
+                f"the route of scene {scene.name!r}: ({points[k, 0]:.2f}, "
+                f"{points[k, 1]:.2f}) is blocked")
+        for k in np.flatnonzero(~joined_in_order(scene, points, radius))[:1] + 1:
             a, b = points[k - 1], points[k]
-            if not connected(scene, a, b, radius):
-                raise ValueError(f"route points {k - 1} ({a[0]:.3f}, {a[1]:.3f}) and {k} "
-                                 f"({b[0]:.3f}, {b[1]:.3f}) are not joined by any path for a "
-                                 f"disc of {radius} m radius in scene {scene.name!r}")
+            raise ValueError(f"route points {k - 1} ({a[0]:.3f}, {a[1]:.3f}) and {k} "
+                             f"({b[0]:.3f}, {b[1]:.3f}) are not joined by any path for a "
+                             f"disc of {radius} m radius in scene {scene.name!r}")
         check_start_jitter(scene, points[0], self.start_jitter[0], radius, "the route's start")
+        check_start_off_goal(points[0], points[1], self.success_radius,
+                             "the route's start and its first target")
 
-    def _check_route_point(self, scene: Scene, k: int, pose: np.ndarray) -> None:
-        """``ValueError`` if point ``k`` of the given route lies outside ``scene.bounds``
-        or closer than the robot's body radius to a wall or object (by how much)."""
+    def _check_straight_fit(self, scene: Scene) -> None:
+        """``ValueError`` if the last target of the straight route would lie outside the
+        scene's bounds less ``path_radius`` (arithmetic: nothing built), saying how many
+        targets fit."""
         (xmin, ymin), (xmax, ymax) = scene.bounds
-        where = f"route point {k} ({pose[0]:.3f}, {pose[1]:.3f})"
-        if not (xmin <= pose[0] <= xmax and ymin <= pose[1] <= ymax):
-            raise ValueError(f"{where} lies outside the bounds of scene {scene.name!r}: "
-                             f"x in [{xmin}, {xmax}], y in [{ymin}, {ymax}] m")
-        free = max(clearance(scene, (pose[0], pose[1])), 0.0)
-        if free < BODY_RADIUS:
-            raise ValueError(f"{where} is {free:.3f} m from the nearest wall or object in "
-                             f"scene {scene.name!r}; the robot's body needs {BODY_RADIUS:.3f} m "
-                             f"({BODY_RADIUS - free:.3f} m short)")
+        x0, y0, yaw = scene.metadata["route_origin"]
+        step = self.spacing * np.array([math.cos(yaw), math.sin(yaw)])
+        low = np.array([xmin, ymin]) + self.path_radius
+        high = np.array([xmax, ymax]) - self.path_radius
+        last = np.array([x0, y0]) + (self.n_targets - 1) * step
+        if np.all((low <= last) & (last <= high)):
+            return
+        with np.errstate(divide="ignore", invalid="ignore"):   # steps along one axis
+            room = np.where(step > 0, (high - (x0, y0)) / step,
+                            np.where(step < 0, (low - (x0, y0)) / step, np.inf))
+        fits = max(int(math.floor(float(np.min(room)))) + 1, 0)
+        raise ValueError(f"{self.n_targets} targets {self.spacing} m apart do not fit along "
+                         f"the route of scene {scene.name!r}: the last would be at "
+                         f"({last[0]:.2f}, {last[1]:.2f}), outside its bounds {scene.bounds} "
+                         f"less {self.path_radius} m; at most {fits} fit")
+
+    @staticmethod
+    def _check_route_points(scene: Scene, points: np.ndarray, free: np.ndarray) -> None:
+        """``ValueError`` naming the first point of the given route that lies outside
+        ``scene.bounds`` or closer than the robot's body radius to a wall or object (by
+        how much); ``free`` holds the points' clearances."""
+        (xmin, ymin), (xmax, ymax) = scene.bounds
+        x, y = points[:, 0], points[:, 1]
+        outside = np.flatnonzero((x < xmin) | (x > xmax) | (y < ymin) | (y > ymax))
+        tight = np.flatnonzero(free < BODY_RADIUS)
+        for k in sorted([*outside[:1], *tight[:1]])[:1]:
+            where = f"route point {k} ({x[k]:.3f}, {y[k]:.3f})"
+            if k in outside:
+                raise ValueError(f"{where} lies outside the bounds of scene {scene.name!r}: "
+                                 f"x in [{xmin}, {xmax}], y in [{ymin}, {ymax}] m")
+            raise ValueError(f"{where} is {free[k]:.3f} m from the nearest wall or object in "
+                             f"scene {scene.name!r}; the robot's body needs {BODY_RADIUS:.3f} "
+                             f"m ({BODY_RADIUS - free[k]:.3f} m short)")
 
     def sample_episode(self, scene: Scene, rng: np.random.Generator) -> Episode:
         before, *targets = self._route(scene)

@@ -25,9 +25,11 @@ from homing_gym.observations import ObservationKey, constant_key
 from homing_gym.paths import connected
 from homing_gym.scenes.base import Scene
 from homing_gym.tasks.context import TaskContext
-from homing_gym.tasks.base import Episode, check_start_jitter
+from homing_gym.tasks.base import (Episode, check_start_jitter, check_start_off_goal,
+                                   checked_start_jitter)
 from homing_gym.tasks.goal_reaching import GoalReachingTask, RewardConfig
 from homing_gym.teaching import PLACE_SPACING, FeatureMap, teach_path, teach_work_location
+from homing_gym.validation import require_number
 from homing_gym.vision import low_resolution_shape
 
 
@@ -63,26 +65,20 @@ class WorkLocationsTask(GoalReachingTask):
                  template_size: int = 17, max_points: int = MAX_POINTS,
                  success_radius: float = 0.1, success_on: str = "stop",
                  reward: RewardConfig = RewardConfig()):
-        if len(start_jitter) != 2 or not all(math.isfinite(v) and v >= 0 for v in start_jitter):
-            raise ValueError(f"start_jitter must be (metres, radians) >= 0, got {start_jitter!r}")
-        if not (isinstance(teach_levels, (int, np.integer)) and 1 <= teach_levels <= 4):
-            raise ValueError(f"teach_levels must be an integer in [1, 4] pyramid steps, "
-                             f"got {teach_levels!r}")
-        if not (math.isfinite(spacing) and 0.05 <= spacing <= 2.0):
-            raise ValueError(f"spacing must be in [0.05, 2] metres, got {spacing!r}")
-        if not (isinstance(template_size, (int, np.integer)) and template_size % 2 == 1
-                and 5 <= template_size <= 63):
+        start_jitter = checked_start_jitter(start_jitter)
+        require_number("teach_levels", teach_levels, 1, 4, "pyramid steps", integer=True)
+        require_number("place_spacing", spacing, 0.05, 2.0, "metres")
+        if require_number("template_size", template_size, 5, 63, "pixels, odd",
+                          integer=True) % 2 == 0:
             raise ValueError(f"template_size must be an odd integer in [5, 63] pixels, "
                              f"got {template_size!r}")
-        if not (isinstance(max_points, (int, np.integer)) and 2 <= max_points <= MAX_POINTS):
-            raise ValueError(f"max_points must be an integer in [2, {MAX_POINTS}], "
-                             f"got {max_points!r}")
+        require_number("max_points", max_points, 2, MAX_POINTS, integer=True)
         if start_location is not None and start_location == goal_location:
             raise ValueError(f"start_location and goal_location are both {start_location!r}; "
                              f"give two different work locations")
         super().__init__(success_radius, success_on, reward)
         self.start_location, self.goal_location = start_location, goal_location
-        self.start_jitter = (float(start_jitter[0]), float(start_jitter[1]))
+        self.start_jitter = start_jitter
         self.levels = int(teach_levels)
         self.spacing = float(spacing)
         self.template_size = int(template_size)
@@ -120,6 +116,8 @@ class WorkLocationsTask(GoalReachingTask):
         for start, goal in self._candidate_paths(scene):
             check_start_jitter(scene, places[start], self.start_jitter[0], START_CLEARANCE,
                                f"the work location {start!r}")
+            check_start_off_goal(places[start], places[goal], self.success_radius,
+                                 f"the work locations {start!r} and {goal!r}")
             if not connected(scene, places[start], places[goal], START_CLEARANCE):
                 raise ValueError(f"scene {scene.name!r}: no path for a disc of "
                                  f"{START_CLEARANCE} m radius leads from the work location "
