@@ -98,33 +98,69 @@ def eval_env_kwargs(train_env_kwargs: dict[str, Any]) -> dict[str, Any]:
     return {k: v for k, v in train_env_kwargs.items() if k != "scene"}
 
 
+#: The largest settings file read beside a policy zip (a run's ``config.yml``, a ``.yml``).
+MAX_SETTINGS_BYTES = 2**20
+#: The fields read from a run's ``config.yml`` and from a shipped policy's ``.yml``, with
+#: their types (each may be absent or null).
+RUN_CONFIG_FIELDS = {"env_id": str, "env_kwargs": dict, "eval_deterministic": bool,
+                     "pretrain_samples": int, "imitation_iterations": int}
+SHIPPED_FIELDS = {"env_id": str, "eval_env_kwargs": dict, "eval_params": dict,
+                  "privileged": str}
+_KINDS = {str: "a text", dict: "a mapping with text keys", bool: "true or false",
+          int: "an integer >= 0"}
+
+
+def _settings_file(path: str, fields: dict[str, type]) -> dict[str, Any]:
+    """The settings mapping in the YAML file ``path`` (read with ``yaml.safe_load``; an
+    empty file is ``{}``), its ``fields`` checked for their types; ``ValueError`` naming
+    the file and the field otherwise."""
+    import yaml
+
+    try:
+        size = os.path.getsize(path)
+        if size > MAX_SETTINGS_BYTES:
+            raise ValueError(f"{path}: {size:,} bytes, more than the {MAX_SETTINGS_BYTES:,} "
+                             f"a settings file may have")
+        with open(path, encoding="utf-8") as file:
+            settings = yaml.safe_load(file)
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as err:
+        raise ValueError(f"{path}: not readable YAML ({' '.join(str(err).split())})") from None
+    if settings is None:
+        return {}
+    if not isinstance(settings, dict):
+        raise ValueError(f"{path}: must map settings to values, got "
+                         f"{type(settings).__name__}")
+    for key, kind in fields.items():
+        value = settings.get(key)
+        ok = value is None or (isinstance(value, kind)
+                               and (kind is bool or not isinstance(value, bool))
+                               and (kind is not int or value >= 0)
+                               and (kind is not dict or all(isinstance(k, str) for k in value)))
+        if not ok:
+            raise ValueError(f"{path}: {key} must be {_KINDS[kind]}, got {value!r:.80}")
+    return settings
+
+
 def recorded_settings(zip_path: str) -> RecordedSettings:
     """The evaluation settings recorded beside the policy zip ``zip_path``: its ``.yml``
     (a shipped policy), else the ``config.yml`` of the ``homing-train`` run folder it lies
     in, directly or in its ``checkpoints/`` (:func:`eval_env_kwargs` of the training env
-    kwargs; sampled actions if the run's evaluations sampled them)."""
-    import yaml
-
+    kwargs; sampled actions if the run's evaluations sampled them). ``ValueError`` naming
+    the file and the field if the file is not such settings (:func:`_settings_file`)."""
     meta_path = os.path.splitext(zip_path)[0] + ".yml"
     folder = os.path.dirname(zip_path)
     if os.path.basename(folder) == "checkpoints":
         folder = os.path.dirname(folder)
     run_config = os.path.join(folder, "config.yml")
     if not os.path.isfile(meta_path) and os.path.isfile(run_config):
-        try:
-            config = yaml.safe_load(open(run_config).read()) or {}
-        except yaml.YAMLError as err:
-            raise ValueError(f"{run_config}: not readable YAML ({err})") from None
+        config = _settings_file(run_config, RUN_CONFIG_FIELDS)
         params = ({"deterministic": False} if config.get("eval_deterministic") is False
                   else {})
         return RecordedSettings(eval_env_kwargs(dict(config.get("env_kwargs") or {})), params,
                                 config.get("env_id"), run_config, privileged_training(config))
     if not os.path.isfile(meta_path):
         return RecordedSettings()
-    try:
-        meta = yaml.safe_load(open(meta_path).read()) or {}
-    except yaml.YAMLError as err:
-        raise ValueError(f"{meta_path}: not readable YAML ({err})") from None
+    meta = _settings_file(meta_path, SHIPPED_FIELDS)
     return RecordedSettings(dict(meta.get("eval_env_kwargs") or {}),
                             dict(meta.get("eval_params") or {}), meta.get("env_id"), meta_path,
                             str(meta.get("privileged") or ""))
