@@ -62,6 +62,7 @@ from homing_baselines.bearing_sim import (ReachabilityMap, SimConfig, circumcirc
 from homing_gym.cli import command_parser, seed_value  # noqa: E402
 from homing_train.figures import MEASURED_WITH  # noqa: E402
 from homing_train.harness.policies import parse_params  # noqa: E402
+from homing_train.outputs import output_dir_argument  # noqa: E402
 
 #: The landmark triangle of the figures (m): scalene, about 2 m a side.
 LANDMARKS = np.array([[-1.0, -0.6], [1.2, -0.5], [0.2, 1.1]])
@@ -582,22 +583,22 @@ def main(argv: list[str] | None = None) -> int:
     parser = command_parser("python -m homing_train.figures.bearing", __doc__)
     sub = parser.add_subparsers(dest="command", required=True)
     rp = sub.add_parser("reachability", help="Fig. 4-style reachability maps of the three laws")
-    rp.add_argument("--out", default="docs/bearing", help="output folder")
+    rp.add_argument("--out", type=output_dir_argument, default="docs/bearing", help="output folder")
     rp.add_argument("--grid", type=int, default=81, help="grid points per axis")
     rp.add_argument("--extent", type=float, default=4.0, help="half-width of the map (m)")
     rp.add_argument("--start", type=float, nargs=2, default=START, help="start A (m)")
     rp.add_argument("--no-progress", action="store_true")
     sp = sub.add_parser("starts", help="the unified law's per-region reach from several starts")
-    sp.add_argument("--out", default="docs/bearing", help="output folder")
+    sp.add_argument("--out", type=output_dir_argument, default="docs/bearing", help="output folder")
     sp.add_argument("--grid", type=int, default=41, help="grid points per axis")
     sp.add_argument("--no-progress", action="store_true")
     f10 = sub.add_parser("fig10", help="Fig. 10 from pixels in the lab scene (81 runs)")
-    f10.add_argument("--out", default="docs/bearing", help="output folder")
+    f10.add_argument("--out", type=output_dir_argument, default="docs/bearing", help="output folder")
     f10.add_argument("--max-steps", type=int, default=800)
     f10.add_argument("--fail-cm", type=float, default=20.0)
     f10.add_argument("--no-progress", action="store_true")
     f11 = sub.add_parser("fig11", help="Fig. 11 from pixels: unified law to marks A-F")
-    f11.add_argument("--out", default="docs/bearing", help="output folder")
+    f11.add_argument("--out", type=output_dir_argument, default="docs/bearing", help="output folder")
     f11.add_argument("--runs", type=int, default=30, help="runs per marked position")
     f11.add_argument("--max-steps", type=int, default=800)
     f11.add_argument("--seed", type=seed_value, default=11,
@@ -605,14 +606,14 @@ def main(argv: list[str] | None = None) -> int:
     f11.add_argument("--no-progress", action="store_true")
     pr = sub.add_parser("pixel-reachability",
                         help="reachability of the three laws from pixels in the lab")
-    pr.add_argument("--out", default="docs/bearing", help="output folder")
+    pr.add_argument("--out", type=output_dir_argument, default="docs/bearing", help="output folder")
     pr.add_argument("--spacing", type=float, default=1.2, help="goal grid spacing (m)")
     pr.add_argument("--max-steps", type=int, default=600)
     pr.add_argument("--fail-cm", type=float, default=20.0)
     pr.add_argument("--no-progress", action="store_true")
     la = sub.add_parser("lab-anywhere",
                         help="the unified law in the lab, homes anywhere, with 2-D reachability")
-    la.add_argument("--out", default="docs/bearing", help="output folder")
+    la.add_argument("--out", type=output_dir_argument, default="docs/bearing", help="output folder")
     la.add_argument("--episodes", type=int, default=40)
     la.add_argument("--seed", type=seed_value, default=0, help="seed of the first episode")
     la.add_argument("--max-steps", type=int, default=800)
@@ -622,7 +623,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="the env's panorama (default: the env's own)")
     la.add_argument("--no-progress", action="store_true")
     lr = sub.add_parser("longrange", help="bearing-longrange on LongRangeHoming-v0")
-    lr.add_argument("--out", default="docs/bearing", help="output folder")
+    lr.add_argument("--out", type=output_dir_argument, default="docs/bearing", help="output folder")
     lr.add_argument("--episodes", type=int, default=10)
     lr.add_argument("--seed", type=seed_value, default=0, help="seed of the first episode")
     lr.add_argument("--route-length", type=float, default=8.0, help="outbound route (m)")

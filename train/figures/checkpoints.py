@@ -28,6 +28,7 @@ import numpy as np
 from homing_gym.cli import command_parser
 from homing_train.harness.matrix import run_cell
 from homing_train.harness.protocols import PROTOCOLS, protocol
+from homing_train.outputs import output_dir_argument
 
 _CHECKPOINT = re.compile(r"ppo_(\d+)_steps\.zip$")
 #: Plot position (env steps) of a run's warm start, drawn before its first PPO step.
@@ -164,7 +165,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--every", type=int, nargs="+", default=[50000],
                         help="score checkpoints this many steps apart (one value for "
                              "every run, or one per run)")
-    parser.add_argument("--out", type=Path, default=Path("docs/generalisation"))
+    parser.add_argument("--out", type=output_dir_argument, default="docs/generalisation")
     parser.add_argument("--no-progress", action="store_true")
     args = parser.parse_args(argv)
     if len(args.every) == 1:
@@ -179,6 +180,7 @@ def main(argv: list[str] | None = None) -> int:
                    for (name, run), every in zip(runs.items(), args.every)}
     except ValueError as err:
         parser.exit(2, f"checkpoints: error: {err}\n")
+    args.out = Path(args.out)
     args.out.mkdir(parents=True, exist_ok=True)
     table = markdown(results, args.protocol)
     (args.out / f"checkpoints_{args.protocol}.md").write_text(table)

@@ -31,6 +31,7 @@ from homing_train.harness.evaluate import EpisodeRecord, EvalResult
 from homing_train.harness.matrix import setting_stem
 from homing_train.harness.metrics import wilson_interval
 from homing_train.harness.palette import method_color
+from homing_train.outputs import output_dir_argument
 
 #: Map tiles (pixels) of ``failures.png``.
 TILE = 220
@@ -163,7 +164,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--cells", required=True,
                         help="a protocol's folder of a homing-suite --protocols run "
                              "(holds <method>/cell.json)")
-    parser.add_argument("--out", default="docs/generalisation", help="output folder")
+    parser.add_argument("--out", type=output_dir_argument, default="docs/generalisation", help="output folder")
     parser.add_argument("--methods", nargs="+",
                         help="methods to show, in this order (default: every one found)")
     args = parser.parse_args(argv)

@@ -34,6 +34,7 @@ from homing_train.figures import MEASURED_WITH
 from homing_train.harness.rollout import prepare_policy, rollout
 from homing_train.harness.field import homing_field, plot_field
 from homing_train.harness.policies import policy_spec
+from homing_train.outputs import output_dir_argument
 
 PANORAMA = (60, 360)   # 1 deg per column, Hong's sampling interval
 LOCAL = "homing_gym/LocalHoming-v0"
@@ -277,7 +278,7 @@ def markdown_tables(results: dict[str, Any]) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     parser = command_parser("python -m homing_train.figures.hong", __doc__)
-    parser.add_argument("--out", default="docs/hong")
+    parser.add_argument("--out", type=output_dir_argument, default="docs/hong")
     parser.add_argument("--only", nargs="+", default=["sweep", "field", "eval", "route"],
                         choices=["signature", "sweep", "field", "eval", "route"])
     parser.add_argument("--episodes", type=int, default=200)

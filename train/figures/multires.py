@@ -36,6 +36,7 @@ from homing_gym.scenes.base import clearance
 from homing_gym.teaching import FeatureMap
 from homing_train.figures import MEASURED_WITH
 from homing_train.harness.rollout import prepare_policy, rollout
+from homing_train.outputs import output_dir_argument
 
 ENV_ID = "homing_gym/WorkLocations-v0"
 LOCATIONS = ("home", "kitchen", "bedroom")
@@ -165,7 +166,7 @@ def _cdf(ax, values, label):
 def main(argv: list[str] | None = None) -> int:
     parser = command_parser("python -m homing_train.figures.multires", __doc__)
     parser.add_argument("experiment", choices=("localisation", "travel"))
-    parser.add_argument("--out", default="docs/multires")
+    parser.add_argument("--out", type=output_dir_argument, default="docs/multires")
     parser.add_argument("--spacing", type=float, default=0.2, help="grid spacing (m)")
     parser.add_argument("--headings", type=int, default=4)
     parser.add_argument("--random-poses", type=int, default=0,

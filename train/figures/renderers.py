@@ -17,6 +17,7 @@ import numpy as np
 import homing_gym  # noqa: F401  (registers the env ids)
 from homing_gym.cli import command_parser, seed_value
 from homing_gym.scenes import available_scenes
+from homing_train.outputs import output_dir_argument
 
 
 def side_by_side(scene: str, seed: int, shape: tuple[int, int]) -> tuple[np.ndarray, float]:
@@ -36,7 +37,7 @@ def side_by_side(scene: str, seed: int, shape: tuple[int, int]) -> tuple[np.ndar
 
 def main(argv: list[str] | None = None) -> int:
     parser = command_parser("python -m homing_train.figures.renderers", __doc__)
-    parser.add_argument("--out", default="docs/images/raycast", help="output folder")
+    parser.add_argument("--out", type=output_dir_argument, default="docs/images/raycast", help="output folder")
     parser.add_argument("--seed", type=seed_value, default=2, help="episode whose start is shown")
     args = parser.parse_args(argv)
     out = Path(args.out)

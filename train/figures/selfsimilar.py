@@ -58,6 +58,7 @@ from homing_baselines.camera_models import PerspectiveModel
 from homing_baselines.selfsimilar_detector import DetectorConfig, detect_landmarks
 from homing_gym.cli import command_parser
 from homing_train.figures import MEASURED_WITH
+from homing_train.outputs import output_dir_argument
 
 #: Frames per second reported by the paper (§3.3) with the speed-ups.
 PAPER_FPS = {(640, 480): 36.0, (320, 240): 81.0}
@@ -407,7 +408,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = command_parser("python -m homing_train.figures.selfsimilar", __doc__)
     parser.add_argument("what", choices=["speed", "detection", "layout", "nav", "memory"])
     parser.add_argument("--runs", help="nav, memory: folder of the homing-eval results")
-    parser.add_argument("--out", default="docs/selfsimilar")
+    parser.add_argument("--out", type=output_dir_argument, default="docs/selfsimilar")
     parser.add_argument("--repeats", type=int, default=200)
     args = parser.parse_args(argv)
     if args.repeats < 1:

@@ -21,6 +21,7 @@ import homing_gym  # noqa: F401  (registers the env ids)
 from homing_gym.cli import command_parser
 from homing_gym.scenes.mesh_example import write_example_room
 from homing_gym.topdown import BG, ROBOT, MapCanvas, labelled, draw_pose, draw_scale_bar, draw_scene
+from homing_train.outputs import output_dir_argument
 
 PANORAMA = (60, 360)
 
@@ -54,7 +55,7 @@ def _pad(image: np.ndarray, height: int) -> np.ndarray:
 
 def main(argv: list[str] | None = None) -> int:
     parser = command_parser("python -m homing_train.figures.worlds", __doc__)
-    parser.add_argument("--out", default="docs/images/worlds", help="output folder")
+    parser.add_argument("--out", type=output_dir_argument, default="docs/images/worlds", help="output folder")
     parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2],
                         help="episodes of the procedural worlds")
     args = parser.parse_args(argv)

@@ -58,6 +58,7 @@ from homing_gym.topdown import HOME, MapCanvas, draw_pose, draw_scene  # noqa: E
 from homing_train.harness.metrics import wilson_interval  # noqa: E402
 from homing_train.figures import MEASURED_WITH  # noqa: E402
 from homing_train.harness.protocols import ring_starts  # noqa: E402
+from homing_train.outputs import checked_output_dir, checked_output_file  # noqa: E402
 
 ENV_ID = "homing_gym/LocalHoming-v0"
 HOME_POSE = (0.0, 0.0, 0.0)  # the nest: arena centre, among the four cylinders
@@ -369,6 +370,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--seed", type=seed_value, default=0)
     args = parser.parse_args(argv)
+    try:                        # before any work: eval writes a JSON file, the others a folder
+        (checked_output_file if args.what == "eval" else checked_output_dir)(args.out)
+    except ValueError as err:
+        parser.error(str(err))
     register_controllers()
     if args.what == "eval":
         from homing_train.harness.evaluate import evaluate, format_summary

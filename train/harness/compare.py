@@ -31,6 +31,8 @@ from homing_train.harness.evaluate import EvalResult  # noqa: E402
 from homing_train.harness.matrix import episode_seconds  # noqa: E402
 from homing_train.harness.palette import (HOME_MARK, START_MARK, method_color,  # noqa: E402
                                           method_color_255)
+from homing_train.outputs import (OutputLock, checked_output_dir,  # noqa: E402
+                                  output_dir_argument, write_text_atomic)
 
 
 
@@ -257,8 +259,7 @@ def compare(paths: Sequence[str], out: str, trajectories: int = 3) -> dict[str, 
         raise ValueError("give at least one result JSON")
     if trajectories < 0:
         raise ValueError(f"trajectories must be >= 0 (0: no map), got {trajectories}")
-    if os.path.exists(out) and not os.path.isdir(out):
-        raise ValueError(f"--out {out!r} is a file; give a folder")
+    checked_output_dir(out)
     results = [EvalResult.load(p) for p in paths]
     check_one_rule(results)
     shared, unpaired = shared_seeds(results)
@@ -266,13 +267,11 @@ def compare(paths: Sequence[str], out: str, trajectories: int = 3) -> dict[str, 
     written = {"table": os.path.join(out, "table.md"),
                "success_vs_distance": os.path.join(out, "success_vs_distance.png"),
                "final_distance": os.path.join(out, "final_distance.png")}
-    with open(written["table"], "w") as f:
-        f.write(markdown_table(results))
-        if routes := route_table(results):
-            f.write("\n" + routes)
-        notes = settings_notes(results) + ([unpaired] if unpaired else [])
-        if notes:
-            f.write("\n" + "".join(f"Note: {n}.\n" for n in notes))
+    routes = route_table(results)
+    notes = settings_notes(results) + ([unpaired] if unpaired else [])
+    write_text_atomic(written["table"], markdown_table(results)
+                      + ("\n" + routes if routes else "")
+                      + ("\n" + "".join(f"Note: {n}.\n" for n in notes) if notes else ""))
     plot_success_vs_distance(results, written["success_vs_distance"])
     plot_final_distance(results, written["final_distance"])
     if trajectories > 0 and shared:
@@ -284,12 +283,14 @@ def compare(paths: Sequence[str], out: str, trajectories: int = 3) -> dict[str, 
 def main(argv: list[str] | None = None) -> int:
     parser = command_parser("homing-compare", __doc__)
     parser.add_argument("results", nargs="+", help="result JSON files of homing-eval")
-    parser.add_argument("--out", required=True, help="output directory")
+    parser.add_argument("--out", required=True, type=output_dir_argument,
+                        help="output directory")
     parser.add_argument("--trajectories", type=int, default=3,
                         help="number of shared episodes drawn on the top-down map")
     args = parser.parse_args(argv)
     try:
-        written = compare(args.results, args.out, args.trajectories)
+        with OutputLock(args.out):
+            written = compare(args.results, args.out, args.trajectories)
     except ValueError as err:
         parser.exit(2, f"homing-compare: error: {err}\n")
     with open(written["table"]) as f:

@@ -33,6 +33,7 @@ from homing_gym.cli import (add_env_arguments, command_parser,  # noqa: E402
 from homing_gym.panorama import bearing_column  # noqa: E402
 from homing_train import DEFAULT_ENV  # noqa: E402
 from homing_train.harness.rollout import prepare_policy, rollout  # noqa: E402
+from homing_train.outputs import output_dir_argument  # noqa: E402
 
 #: The observation keys the views figure shows (added to any ``obs_keys`` given).
 VIEW_KEYS = ("panorama", "goal", "omni", "signature")
@@ -90,7 +91,8 @@ def views_figure(env: gym.Env, seed: int, path: Path) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     parser = command_parser("homing-demo", __doc__)
-    parser.add_argument("--out", default="demo", help="output folder")
+    parser.add_argument("--out", default="demo", type=output_dir_argument,
+                        help="output folder")
     parser.add_argument("--seed", type=seed_value, default=9)
     add_env_arguments(parser, DEFAULT_ENV)
     args = parser.parse_args(argv)

@@ -18,6 +18,7 @@ Command line (also ``python -m homing_train.harness.field``)::
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import os
@@ -32,6 +33,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.backend_bases import FigureCanvasBase  # noqa: E402
 
 from homing_gym.cli import command_parser, env_kwargs_from_args  # noqa: E402
 from homing_gym.geometry import wrap_angle  # noqa: E402
@@ -44,6 +46,8 @@ from homing_train.harness.palette import HOME_MARK  # noqa: E402
 from homing_train.harness.policies import PolicySpec, policy_spec  # noqa: E402
 from homing_train.harness.protocols import PROTOCOLS, protocol  # noqa: E402
 from homing_train.harness.rollout import prepare_policy, rollout  # noqa: E402
+from homing_train.outputs import (OutputLock, atomic_path,  # noqa: E402
+                                  output_file_argument, write_text_atomic)
 
 # colour-blind-safe (Okabe & Ito): returned blue, not returned vermillion, unknown grey
 RETURNED, FAILED, UNKNOWN = (0, 114, 178), (213, 94, 0), (110, 110, 110)
@@ -207,8 +211,22 @@ def plot_field(result: FieldResult, path: str, size: int = 480) -> None:
                   f"(blue: returned, vermillion: not)")
     ax.set_title(title, fontsize=10)
     fig.tight_layout()
-    fig.savefig(path)
+    with atomic_path(path) as tmp:          # the format named by the extension
+        fig.savefig(tmp, format=os.path.splitext(path)[1].lstrip(".").lower() or None)
     plt.close(fig)
+
+
+def picture_argument(text: str) -> str:
+    """``--out``'s type: a picture file that can be written, in a format matplotlib
+    writes (named by its extension), with its scores' ``.json`` beside."""
+    output_file_argument(text)
+    output_file_argument(os.path.splitext(text)[0] + ".json")
+    formats = FigureCanvasBase.get_supported_filetypes()
+    if os.path.splitext(text)[1].lstrip(".").lower() not in formats:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: the picture's format comes from its extension; use one of "
+            f"{', '.join('.' + f for f in sorted(formats))}")
+    return text
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -220,36 +238,43 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--grid", type=float, default=0.2, help="grid spacing (m)")
     parser.add_argument("--no-return", action="store_true",
                         help="skip the return-ratio runs (arrows only, fast)")
-    parser.add_argument("--out", required=True, help="PNG path (scores go to a .json beside)")
+    parser.add_argument("--out", required=True, type=picture_argument,
+                        help="PNG path (scores go to a .json beside)")
     args = parser.parse_args(argv)
     try:
-        env_kwargs = env_kwargs_from_args(args)
-        env_id, seed, home, drawn_in = args.env, args.seed or 0, None, None
-        if args.protocol:
-            if args.env != DEFAULT_ENV or env_kwargs:
-                raise ValueError("--protocol fixes the env, its kwargs and the home; drop "
-                                 "--env/--env-kwargs/--scene")
-            chosen = protocol(args.protocol)
-            if args.seed is not None:
-                chosen = chosen.reseeded(args.seed)
-            setting = chosen.settings[0]
-            env_id, env_kwargs = setting.env_id, setting.kwargs()
-            seed, _, home = setting.episode_tasks(1, chosen.seed)[0]
-            drawn_in = chosen.label
-        result = homing_field(policy_from_args(args), env_id, args.grid, seed,
-                              env_kwargs, run_to_end=not args.no_return,
-                              workers=args.workers, progress=not args.quiet, home=home)
+        with OutputLock(args.out):          # one run at a time on a picture
+            return _field(args)
     except ValueError as err:
         parser.exit(2, f"homing-field: error: {err}\n")
-    os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
+    except KeyboardInterrupt:
+        parser.exit(130, f"homing-field: interrupted; {args.out} was not written\n")
+
+
+def _field(args) -> int:
+    """Compute the field the options ask for, draw it and write its scores."""
+    env_kwargs = env_kwargs_from_args(args)
+    env_id, seed, home, drawn_in = args.env, args.seed or 0, None, None
+    if args.protocol:
+        if args.env != DEFAULT_ENV or env_kwargs:
+            raise ValueError("--protocol fixes the env, its kwargs and the home; drop "
+                             "--env/--env-kwargs/--scene")
+        chosen = protocol(args.protocol)
+        if args.seed is not None:
+            chosen = chosen.reseeded(args.seed)
+        setting = chosen.settings[0]
+        env_id, env_kwargs = setting.env_id, setting.kwargs()
+        seed, _, home = setting.episode_tasks(1, chosen.seed)[0]
+        drawn_in = chosen.label
+    result = homing_field(policy_from_args(args), env_id, args.grid, seed,
+                          env_kwargs, run_to_end=not args.no_return,
+                          workers=args.workers, progress=not args.quiet, home=home)
     plot_field(result, args.out)
     doc = asdict(result)
     doc["extra"] = {k: v for k, v in result.extra.items() if k != "scene"}
     doc["env_kwargs"] = env_kwargs
     if drawn_in:
         doc["protocol"] = drawn_in          # with the note when not its canonical draw
-    with open(os.path.splitext(args.out)[0] + ".json", "w") as f:
-        json.dump(doc, f)
+    write_text_atomic(os.path.splitext(args.out)[0] + ".json", json.dumps(doc))
     ratio = "n/a" if result.return_ratio is None else f"{100 * result.return_ratio:.1f}%"
     print(f"{result.policy}: {len(result.points)} grid points, AAE {result.aae_deg:.1f} deg, "
           f"homeward component {result.homeward:.3f}, return ratio {ratio}")

@@ -33,7 +33,7 @@ import re
 import sys
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Sequence
+from typing import Callable, Sequence
 
 import gymnasium as gym
 import matplotlib
@@ -51,6 +51,7 @@ from homing_train.harness.policies import (ShippedPolicy, recorded_settings,  # 
 from homing_train.harness.metrics import aggregate_success, wilson_interval  # noqa: E402
 from homing_train.harness.protocols import (POLICIES, PROTOCOLS, Protocol,  # noqa: E402
                                             episodes_key)
+from homing_train.outputs import write_text_atomic  # noqa: E402
 
 #: The control period (s) that protocols count ``max_episode_steps`` in.
 BASE_PERIOD = 0.1
@@ -136,6 +137,35 @@ def equal_time_kwargs(setting_kwargs: dict, recorded: dict, default_steps: int |
     return merged
 
 
+def made_for_text(method: str) -> str:
+    """Where ``method`` applies: a controller's envs and scenes
+    (:meth:`homing_baselines.Controller.made_for`), a shipped policy's training env."""
+    if method in homing_baselines.available():
+        cls = homing_baselines.controller_class(method)
+        parts = [f"envs {list(cls.envs)}" if cls.envs is not None else "",
+                 f"scenes {list(cls.scenes)}" if cls.scenes is not None else ""]
+        return "made for " + (" in ".join(p for p in parts if p) or "any env")
+    shipped = shipped_policies().get(method)
+    return (f"a policy trained on {shipped.env_id}" if shipped is not None
+            else "not a controller or a shipped policy")
+
+
+def applicable(methods: Sequence[str], allowed: set[str], where: Callable[[], str]
+               ) -> list[str]:
+    """The ``methods`` in ``allowed`` (those that can run ``where()``, e.g. "protocol
+    yukim"), in order; the others are left out with a printed note saying why
+    (:func:`made_for_text`), or, when none is left, ``ValueError`` saying it."""
+    kept = [m for m in methods if m in allowed]
+    left_out = [m for m in methods if m not in allowed]
+    if left_out:
+        why = "; ".join(f"{m}: {made_for_text(m)}" for m in left_out)
+        if not kept:
+            raise ValueError(f"{', '.join(left_out)} cannot run in {where()} ({why}); "
+                             f"nothing left to run")
+        print(f"note: left out {', '.join(left_out)}, which cannot run in {where()} ({why})")
+    return kept
+
+
 def setting_stem(label: str) -> str:
     """The file stem of a setting's results in a cell's folder (``hallway (held out)`` ->
     ``hallway_held_out``)."""
@@ -161,6 +191,15 @@ def run_cell(protocol: Protocol, method: str, out: Path, episodes: int | None = 
     if method not in shipped and method not in homing_baselines.available():
         raise ValueError(f"unknown method {method!r} for protocol {protocol.name!r}; "
                          f"allowed: {cell_methods(protocol)} or a PPO model .zip")
+    if method in homing_baselines.available() and method not in protocol.methods:
+        made_for = homing_baselines.controller_class(method).made_for
+        misfit = [f"{s.label!r} ({s.env_id}, scene {_scene(s)!r})" for s in protocol.settings
+                  if not made_for(s.env_id, _scene(s))]
+        if misfit:
+            raise ValueError(f"{method} cannot run in protocol {protocol.name!r}: it is "
+                             f"{made_for_text(method)}, and the protocol's settings "
+                             f"{', '.join(misfit)} are not; its methods: "
+                             f"{cell_methods(protocol)}")
     out.mkdir(parents=True, exist_ok=True)
     records: list[EpisodeRecord] = []
     per_setting = {}
@@ -190,8 +229,14 @@ def run_cell(protocol: Protocol, method: str, out: Path, episodes: int | None = 
                 summary=summarize(records, radius=radius), settings=per_setting,
                 privileged="; ".join(p for p in (protocol.privileged, own) if p),
                 seed=protocol.seed, canonical_draw=protocol.canonical)
-    (out / "cell.json").write_text(json.dumps(asdict(cell), indent=1))
+    write_text_atomic(str(out / "cell.json"), json.dumps(asdict(cell), indent=1))
     return cell
+
+
+def _scene(setting) -> str | None:
+    """The scene name a protocol's setting gives its env (``None``: the env's default)."""
+    scene = setting.env_kwargs.get("scene")
+    return getattr(scene, "name", scene)
 
 
 def run_matrix(protocols: Sequence[Protocol], out: Path, episodes: int | None = None,
@@ -201,7 +246,11 @@ def run_matrix(protocols: Sequence[Protocol], out: Path, episodes: int | None = 
     """Every applicable method (or those of ``methods`` that apply) on every protocol;
     cells under ``out/<protocol>/<method>/``, the matrix files in ``out``. With
     ``resume`` the cells of an earlier ``out/matrix.json`` that were not run again (other
-    methods or protocols) stay in the matrix."""
+    methods or protocols) stay in the matrix. Of ``methods``, those that apply to none of
+    ``protocols`` are left out with a note (``ValueError`` if none is left)."""
+    if methods:
+        methods = applicable(list(methods), {m for p in protocols for m in cell_methods(p)},
+                             lambda: "the protocols " + ", ".join(p.name for p in protocols))
     cells = []
     for protocol in protocols:
         for method in cell_methods(protocol):
@@ -438,8 +487,8 @@ def write_matrix(cells: Sequence[Cell], out: Path) -> dict[str, str]:
     """``matrix.md``, ``.csv``, ``.json`` and ``.png`` in ``out``."""
     out.mkdir(parents=True, exist_ok=True)
     written = {kind: str(out / f"matrix.{kind}") for kind in ("md", "csv", "json", "png")}
-    Path(written["md"]).write_text(matrix_markdown(cells))
-    Path(written["json"]).write_text(json.dumps([asdict(c) for c in cells], indent=1))
+    write_text_atomic(written["md"], matrix_markdown(cells))
+    write_text_atomic(written["json"], json.dumps([asdict(c) for c in cells], indent=1))
     keys = ("episodes", "success_rate", "success_ci", "reached_rate", "reached_ci", "spl",
             "final_distance_mean")
     with open(written["csv"], "w", newline="") as f:

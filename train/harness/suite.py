@@ -37,35 +37,48 @@ from homing_gym.cli import add_env_arguments, command_parser, env_kwargs_from_ar
 from homing_train.extras import missing_extra
 from homing_train.harness.compare import compare
 from homing_train.harness.evaluate import (DEFAULT_ENV, add_backend_arguments, check_env_id,
-                                           evaluate, format_summary)
-from homing_train.harness.matrix import (BASE_PERIOD, equal_time_kwargs, matrix_markdown,
-                                         run_matrix)
+                                           evaluate, format_summary, stream_path)
+from homing_train.harness.matrix import (BASE_PERIOD, applicable, equal_time_kwargs,
+                                         matrix_markdown, run_matrix)
 from homing_train.harness.policies import shipped_policies
 from homing_train.harness.protocols import PROTOCOLS, protocol
+from homing_train.outputs import OutputLock, output_dir_argument
 
 def suite_methods(env_id: str, env_kwargs: dict[str, Any] | None = None) -> list[str]:
     """The registered controllers made for ``env_id`` in the scene that ``env_kwargs``
     give it (default: its default scene; :meth:`baselines.Controller.made_for`): e.g.
     ``multires`` only on WorkLocations-v0, the colour-identity bearing laws only in the
     ``lab``. Making the env checks ``env_kwargs``."""
-    env = gym.make(env_id, **(env_kwargs or {}))
-    scene = env.unwrapped.scene.name
-    env.close()
+    scene = scene_name(env_id, env_kwargs)
     return [name for name in homing_baselines.available()
             if homing_baselines.controller_class(name).made_for(env_id, scene)]
+
+
+def scene_name(env_id: str, env_kwargs: dict[str, Any] | None = None) -> str:
+    """The name of the scene that ``env_kwargs`` give ``env_id`` (made to find it out)."""
+    env = gym.make(env_id, **(env_kwargs or {}))
+    try:
+        return env.unwrapped.scene.name
+    finally:
+        env.close()
 
 
 def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: int = 0,
               workers: int = 2, methods: list[str] | None = None, backend: str = "local",
               address: str | None = None, success_on: str = "stop",
-              env_kwargs: dict[str, Any] | None = None) -> dict[str, str]:
+              env_kwargs: dict[str, Any] | None = None,
+              resume: bool = False) -> dict[str, str]:
     """Evaluate the methods (default: all controllers and shipped policies made for the
     env and its scene) and compare, every row with the same success rule ``success_on``
     (``"stop"``: the agent stopped at the goal, the protocols' rule; ``"reach"``: came
     within the radius at any time) and the same ``env_kwargs`` (e.g. the scene), a
     learned row under them as in a protocol's setting
     (:func:`~homing_train.harness.matrix.equal_time_kwargs`: its own input format and
-    control period, and the controllers' time)."""
+    control period, and the controllers' time). Each method's episodes are streamed to
+    ``<method>.episodes.jsonl`` as they end, so an interrupt keeps them; with ``resume``
+    those already there are kept and only the others run. Of ``methods``, a controller
+    not made for the env and its scene is left out with a note (``ValueError`` if none
+    is left)."""
     if success_on not in ("stop", "reach"):
         raise ValueError(f"unknown success rule {success_on!r}; allowed: 'stop', 'reach'")
     check_env_id(env_id)
@@ -84,6 +97,8 @@ def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: in
     unknown = sorted(set(chosen) - set(candidates))
     if unknown:
         raise ValueError(f"unknown methods {unknown}; available: {candidates}")
+    chosen = applicable(chosen, set(made_for) | set(policies),
+                        lambda: f"{env_id} in scene {scene_name(env_id, env_kwargs)!r}")
     learned = sorted(set(chosen) & set(policies))
     out.mkdir(parents=True, exist_ok=True)
     paths = []
@@ -94,10 +109,11 @@ def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: in
             str(shipped.path),
             equal_time_kwargs(setting, shipped.env_kwargs, gym.spec(env_id).max_episode_steps),
             shipped.params) if shipped else (name, setting, {})
-        result = evaluate(policy, env_id, episodes=episodes, seed=seed, env_kwargs=kwargs,
-                          workers=workers, params=params, backend=backend, address=address)
-        print(format_summary(result))
         path = out / f"{name}.json"
+        result = evaluate(policy, env_id, episodes=episodes, seed=seed, env_kwargs=kwargs,
+                          workers=workers, params=params, backend=backend, address=address,
+                          stream=stream_path(str(path)), resume=resume)
+        print(format_summary(result))
         result.save(str(path))
         paths.append(str(path))
     return compare(paths, str(out))
@@ -121,41 +137,49 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--success-on", choices=("stop", "reach"), default="stop",
                         help="the success rule of every row (without --protocols): stopped at "
                         "the goal, or came within its radius at any time")
-    parser.add_argument("--out", default="results", help="output folder (default: results)")
+    parser.add_argument("--out", default="results", type=output_dir_argument,
+                        help="output folder (default: results)")
     parser.add_argument("--resume", action="store_true",
-                        help="with --protocols: keep the episodes already streamed into --out "
-                        "(an interrupted matrix, or one to which protocols or methods were "
-                        "added) and run only the others; the cells of --out's matrix.json "
-                        "that this run does not cover stay in it")
+                        help="keep the episodes already streamed into --out (an interrupted "
+                        "run, or one to which methods or protocols were added) and run only "
+                        "the others; with --protocols the cells of --out's matrix.json that "
+                        "this run does not cover stay in it")
     add_backend_arguments(parser)
     args = parser.parse_args(argv)
     if (args.episodes is not None and args.episodes < 1) or args.workers < 1:
         parser.error("--episodes and --workers must be >= 1")
-    if args.protocols:
-        if args.env != DEFAULT_ENV or args.env_kwargs or args.scene:
-            parser.error("--protocols fix the envs and their kwargs; drop "
-                         "--env/--env-kwargs/--scene")
-        try:
-            names = sorted(PROTOCOLS) if args.protocols == ["all"] else args.protocols
-            chosen = [protocol(name) for name in names]
-            if args.seed is not None:
-                chosen = [p.reseeded(args.seed) for p in chosen]
-            cells = run_matrix(chosen, Path(args.out), args.episodes, args.workers,
-                               args.methods, resume=args.resume, backend=args.backend,
-                               address=args.ray_address)
-        except ValueError as err:
-            parser.exit(2, f"homing-suite: error: {err}\n")
-        print(matrix_markdown(cells))
-        print(f"wrote {args.out}/matrix.md, matrix.csv, matrix.json, matrix.png")
-        return 0
-    if args.episodes is None:
-        args.episodes = 20
+    if args.protocols and (args.env != DEFAULT_ENV or args.env_kwargs or args.scene):
+        parser.error("--protocols fix the envs and their kwargs; drop --env/--env-kwargs/--scene")
     try:
-        written = run_suite(Path(args.out), args.env, args.episodes, args.seed or 0,
-                            args.workers, args.methods, args.backend, args.ray_address,
-                            args.success_on, env_kwargs_from_args(args))
+        with OutputLock(args.out):      # one run at a time in a folder
+            return _matrix(args) if args.protocols else _suite(args)
     except ValueError as err:
         parser.exit(2, f"homing-suite: error: {err}\n")
+    except KeyboardInterrupt:
+        parser.exit(130, f"homing-suite: interrupted; the finished episodes are in the "
+                         f"*.episodes.jsonl files under {args.out}/: the same command with "
+                         f"--resume runs the rest\n")
+
+
+def _matrix(args) -> int:
+    """``--protocols``: run the matrix and print it."""
+    names = sorted(PROTOCOLS) if args.protocols == ["all"] else args.protocols
+    chosen = [protocol(name) for name in names]
+    if args.seed is not None:
+        chosen = [p.reseeded(args.seed) for p in chosen]
+    cells = run_matrix(chosen, Path(args.out), args.episodes, args.workers, args.methods,
+                       resume=args.resume, backend=args.backend, address=args.ray_address)
+    print(matrix_markdown(cells))
+    print(f"wrote {args.out}/matrix.md, matrix.csv, matrix.json, matrix.png")
+    return 0
+
+
+def _suite(args) -> int:
+    """Without ``--protocols``: every method on one env, compared."""
+    written = run_suite(Path(args.out), args.env, 20 if args.episodes is None else args.episodes,
+                        args.seed or 0, args.workers, args.methods, args.backend,
+                        args.ray_address, args.success_on, env_kwargs_from_args(args),
+                        resume=args.resume)
     print(Path(written["table"]).read_text())
     print("wrote " + ", ".join(written.values()))
     return 0
