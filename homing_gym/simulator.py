@@ -12,12 +12,15 @@ Physics: ``time_step`` (the env's default 1/120 s) per ``stepSimulation``; the e
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import os
 import pkgutil
 import sys
 import tempfile
+import threading
 import warnings
+from collections.abc import Iterator
 
 import numpy as np
 import pybullet as p
@@ -40,6 +43,16 @@ from homing_gym.worldmesh import world_mesh
 #: with 40 trees). Contacts and trajectories are bit for bit the same (checked on every
 #: built-in scene, both drives and 10,000-triangle worlds).
 _STATIC = {"useMaximalCoordinates": True}
+#: PyBullet's limits on one mesh shape given as arrays: corners and indices
+#: (``B3_MAX_NUM_VERTICES``, ``B3_MAX_NUM_INDICES`` in its ``SharedMemoryPublic.h``; a
+#: macOS build's are 8,192 and 32,768). A larger one fails with "Number of indices
+#: exceeds the maximum".
+MAX_SHAPE_VERTICES, MAX_SHAPE_INDICES = ((8_192, 32_768) if sys.platform == "darwin"
+                                         else (131_072, 524_288))
+#: Triangles of one PyBullet mesh shape: that many use at most three times as many
+#: corners and indices, within both limits (43,690; 2,730 on macOS). A mesh part with
+#: more is split into several shapes (:func:`_face_chunks`).
+MAX_SHAPE_FACES = min(MAX_SHAPE_VERTICES, MAX_SHAPE_INDICES) // 3
 
 
 class Simulator:
@@ -138,21 +151,24 @@ class Simulator:
         PyBullet mesh takes one colour)."""
         c, bodies = self.client, []
         faces = part.faces[band_faces(part, band)] if part.collision else part.faces[:0]
-        if len(faces):
-            vertices, indices = _used_vertices(part.vertices, faces)
-            col = c.createCollisionShape(p.GEOM_MESH, vertices=vertices, indices=indices,
-                                         flags=p.GEOM_FORCE_CONCAVE_TRIMESH)
+        for chunk in _face_chunks(part.vertices, faces) if len(faces) else ():
+            with _MESH_LISTS.lent(*_used_vertices(part.vertices, chunk)) as (vertices, indices):
+                col = c.createCollisionShape(p.GEOM_MESH, vertices=vertices, indices=indices,
+                                             flags=p.GEOM_FORCE_CONCAVE_TRIMESH)
             bodies.append(c.createMultiBody(0, col, -1, [0, 0, 0], **_STATIC))
             self._hide(bodies[-1])
         if self._drawn:
             levels = np.round(part.face_colors * 16).astype(np.int64)
             keys = (levels[:, 0] * 17 + levels[:, 1]) * 17 + levels[:, 2]
             for key in np.unique(keys):
-                vertices, indices = _used_vertices(part.vertices, part.faces[keys == key])
-                vis = c.createVisualShape(p.GEOM_MESH, vertices=vertices, indices=indices,
-                                          rgbaColor=[*(levels[keys == key][0] / 16), 1.0])
-                bodies.append(c.createMultiBody(0, -1, vis, [0, 0, 0], **_STATIC))
-                c.changeVisualShape(bodies[-1], -1, textureUniqueId=-1)   # no default checker
+                for chunk in _face_chunks(part.vertices, part.faces[keys == key]):
+                    with _MESH_LISTS.lent(*_used_vertices(part.vertices, chunk)) as (
+                            vertices, indices):
+                        vis = c.createVisualShape(
+                            p.GEOM_MESH, vertices=vertices, indices=indices,
+                            rgbaColor=[*(levels[keys == key][0] / 16), 1.0])
+                    bodies.append(c.createMultiBody(0, -1, vis, [0, 0, 0], **_STATIC))
+                    c.changeVisualShape(bodies[-1], -1, textureUniqueId=-1)   # no checker
         return bodies
 
     def _body(self, solid: Solid, visible: bool = True) -> int:
@@ -170,8 +186,10 @@ class Simulator:
             vis = c.createVisualShape(p.GEOM_CYLINDER, radius=solid.radius,
                                       length=solid.height, rgbaColor=list(solid.color))
         elif visible and solid.shape == "panel":
-            vis = c.createVisualShape(p.GEOM_MESH, **_panel_mesh(solid.half),
-                                      rgbaColor=list(solid.color))
+            vertices, indices, uvs, normals = _panel_mesh(solid.half)
+            with _MESH_LISTS.lent(vertices, indices, uvs, normals) as (v, i, uv, n):
+                vis = c.createVisualShape(p.GEOM_MESH, vertices=v, indices=i, uvs=uv,
+                                          normals=n, rgbaColor=list(solid.color))
         elif visible:
             vis = c.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=list(solid.color))
         body = c.createMultiBody(0, col, vis, list(solid.centre),
@@ -252,20 +270,68 @@ class Simulator:
         return self._connected
 
 
-def _used_vertices(vertices: np.ndarray, faces: np.ndarray) -> tuple[list, list]:
-    """The corners that ``faces`` use (in their order in ``vertices``) and the faces'
-    indices into them, as the lists PyBullet's mesh shapes take. PyBullet keeps a
-    reference to every vertex it is given (its ``extractVertices`` never releases
-    them), so a mesh passes only its own corners: that memory is lost for good."""
+def _face_chunks(vertices: np.ndarray, faces: np.ndarray) -> list[np.ndarray]:
+    """``faces`` in groups that PyBullet takes as one mesh shape (at most
+    :data:`MAX_SHAPE_FACES` each): all in one if they fit, else ordered by their centres'
+    x, so that each group covers a strip of the world (small bounding boxes for the
+    broad phase)."""
+    if len(faces) <= MAX_SHAPE_FACES:
+        return [faces]
+    order = np.argsort(vertices[faces, 0].mean(axis=1), kind="stable")
+    return np.array_split(faces[order], -(-len(faces) // MAX_SHAPE_FACES))
+
+
+def _used_vertices(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The corners ``(C, 3)`` that ``faces`` use (in their order in ``vertices``) and the
+    faces' indices into them ``(3 F,)``: what one of PyBullet's mesh shapes takes."""
     used, inverse = np.unique(faces, return_inverse=True)
-    return vertices[used].tolist(), inverse.ravel().tolist()
+    return vertices[used], inverse.ravel()
 
 
-def _panel_mesh(half) -> dict[str, list]:
-    """``createVisualShape`` arguments of a panel's box of half extents ``half``
-    (metres): its local +y face carries the whole texture once (u left to right as seen
-    from the front, v bottom to top); the other faces sample the texture's top-left
-    corner."""
+class _ReusedLists:
+    """The lists given to PyBullet's mesh shapes (``vertices``, ``indices``, ``uvs``,
+    ``normals``), refilled for every shape. PyBullet 3.2.7 never releases those sequences
+    nor any corner in them (its ``extractVertices`` and ``extractIndices`` keep the
+    references they take), so fresh lists for each shape stayed in memory for the life
+    of the process (about 0.13 MiB a ``random_nature`` world). Reused lists hold only
+    the largest shape's numbers (at most :data:`MAX_SHAPE_VERTICES` corners). One per
+    process, locked: envs in threads share it."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._lists: list[list] = []            # one per argument position
+        self._rows: list[list[list[float]]] = []
+
+    @contextlib.contextmanager
+    def lent(self, *arrays) -> Iterator[list[list]]:
+        """``arrays`` (1-D: numbers; 2-D: rows of numbers) as the reused lists, theirs
+        until the block ends."""
+        with self._lock:
+            yield [self._refilled(k, np.asarray(a)) for k, a in enumerate(arrays)]
+
+    def _refilled(self, position: int, array: np.ndarray) -> list:
+        while len(self._lists) <= position:
+            self._lists.append([])
+            self._rows.append([])
+        items, rows = self._lists[position], self._rows[position]
+        if array.ndim == 1:
+            items[:] = array.tolist()
+            return items
+        rows.extend([] for _ in range(len(array) - len(rows)))
+        for row, values in zip(rows, array.tolist()):
+            row[:] = values
+        items[:] = rows[:len(array)]
+        return items
+
+
+_MESH_LISTS = _ReusedLists()
+
+
+def _panel_mesh(half) -> tuple[list, list, list, list]:
+    """The vertices, indices, uvs and normals of a panel's box of half extents ``half``
+    (metres), as ``createVisualShape`` takes them: its local +y face carries the whole
+    texture once (u left to right as seen from the front, v bottom to top); the other
+    faces sample the texture's top-left corner."""
     hx, hy, hz = half
     corner = [0.001, 0.999]
     vertices, normals, uvs, indices = [], [], [], []
@@ -288,7 +354,7 @@ def _panel_mesh(half) -> dict[str, list]:
                 uvs.append([0.5 - v[0] / (2 * hx), 0.5 + v[2] / (2 * hz)] if front else corner)
             k = len(vertices) - 4
             indices += [k, k + 1, k + 2, k, k + 2, k + 3]
-    return {"vertices": vertices, "indices": indices, "uvs": uvs, "normals": normals}
+    return vertices, indices, uvs, normals
 
 
 def gui_unavailable() -> str | None:

@@ -16,7 +16,7 @@ from weakref import WeakKeyDictionary
 import numpy as np
 
 from homing_gym.scenes.footprint import ClearanceField, clearance_field
-from homing_gym.scenes.mesh_part import MeshPart
+from homing_gym.scenes.mesh_part import MeshPart, check_face_count
 from homing_gym.textures import check_texture
 from homing_gym.validation import require_positive
 
@@ -168,6 +168,7 @@ class Scene:
                              f"xmax,ymax")
         if not all(isinstance(m, MeshPart) for m in self.meshes):
             raise ValueError(f"scene {self.name!r}: meshes must be MeshPart objects")
+        check_face_count(sum(len(m.faces) for m in self.meshes), f"scene {self.name!r}")
         low, high = self.height_band
         if not (0 <= low < high):
             raise ValueError(f"scene {self.name!r}: height_band must be (low, high) metres "

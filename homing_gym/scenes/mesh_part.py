@@ -16,6 +16,23 @@ from functools import cached_property
 import numpy as np
 
 
+#: The most triangles the meshes of one world may hold together. Measured (2026-11-28,
+#: 2 cores): a 20 m terrain grid of 1,000,000 triangles took 25 s to become an env and
+#: 1.8 GB at its peak, one of 2,000,000 took 49 s and 3.4 GB (the clearance field, the
+#: ray caster's mesh and PyBullet's trees of the blocking ones, in shapes of at most
+#: 43,690 triangles each).
+MAX_WORLD_FACES = 2_000_000
+
+
+def check_face_count(count: int, owner: str) -> None:
+    """``ValueError`` naming ``owner`` (e.g. "mesh file 'x.ply'"), ``count`` and the
+    limit when ``count`` triangles are more than :data:`MAX_WORLD_FACES`."""
+    if count > MAX_WORLD_FACES:
+        raise ValueError(f"{owner} has {count:,} triangles, more than the {MAX_WORLD_FACES:,} "
+                         f"a world may hold (loading takes about 25 s and 1.8 GB a million); "
+                         f"simplify the mesh, e.g. with a decimation tool")
+
+
 @dataclass(frozen=True, eq=False)
 class MeshPart:
     """``vertices`` ``(V, 3)`` (metres), ``faces`` ``(F, 3)`` vertex indices,

@@ -50,7 +50,7 @@ import numpy as np
 
 from homing_gym.scenes.base import HEIGHT_BAND, MAX_COORDINATE, Color, Scene
 from homing_gym.scenes.footprint import band_triangles
-from homing_gym.scenes.mesh_part import MeshPart
+from homing_gym.scenes.mesh_part import MeshPart, check_face_count
 from homing_gym.validation import is_real, require_positive
 
 UP_AXES = ("z", "y")
@@ -210,6 +210,7 @@ class MeshScene(Scene):
     def _build(cls, parts: list[MeshPart], name: str, options: MeshOptions) -> "MeshScene":
         if not parts:
             raise ValueError(f"mesh scene {name!r} has no mesh parts")
+        check_face_count(sum(len(p.faces) for p in parts), f"mesh scene {name!r}")
         unknown = sorted(set(options.no_collision) - {p.name for p in parts})
         if unknown:
             raise ValueError(f"no_collision names {unknown} are not parts of {name!r}; its "
@@ -268,6 +269,7 @@ def load_parts(path: str | os.PathLike) -> list[MeshPart]:
     if not meshes:
         raise ValueError(f"mesh file {path!r} has no triangles (empty, or only points "
                          f"or lines)")
+    check_face_count(sum(len(m.faces) for m in meshes), f"mesh file {path!r}")
     try:
         return [_part(m, str(m.metadata.get("name") or m.metadata.get("node")
                              or os.path.basename(path))) for m in meshes]
