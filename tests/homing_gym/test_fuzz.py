@@ -19,9 +19,11 @@ asking for no time limit (the env cards in ``docs/envs/``), so it is not counted
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 import tempfile
+import zipfile
 from collections import Counter
 from concurrent.futures import ThreadPoolExecutor
 
@@ -89,7 +91,25 @@ BAD_COMMANDS = [   # (module of the command, arguments)
     ("homing_train.harness.suite", ["--env", "nope/Nope-v0", "--out", "{tmp}/suite"]),
     ("homing_train.harness.field", ["--policy", "warping", "--grid", "1e-6", "--no-return",
                                     "--out", "{tmp}/f.png"]),
+    ("homing_train.harness.eval_command", ["--policy", "{tmp}/huge_obs.zip", "--out",
+                                           "{tmp}/r.json"]),
+    ("homing_train.harness.eval_command", ["--policy", "{tmp}/huge_net.zip", "--out",
+                                           "{tmp}/r.json"]),
+    ("homing_train.harness.eval_command", ["--policy", "{tmp}/unknown_key.zip", "--out",
+                                           "{tmp}/r.json"]),
+    ("homing_train.harness.eval_command", ["--policy", "{tmp}/run/model.zip", "--out",
+                                           "{tmp}/r.json"]),
 ]
+#: Policy files from others that command cases name as ``{tmp}/NAME``: the shipped
+#: ppo_procedural_fast.zip's data and weights with ``data[entry][key] = value``, or as
+#: shipped (``None``) in a run folder whose ``config.yml`` is not YAML.
+POLICY_FILES = {
+    "huge_obs.zip": ("observation_space", "spaces", "{'goal': Box(0, 255, (100000, 100000, "
+                     "3), uint8), 'panorama': Box(0, 255, (3, 16, 64), uint8)}"),
+    "huge_net.zip": ("policy_kwargs", "net_arch", "[1000000000]"),
+    "unknown_key.zip": ("policy_kwargs", "bogus", "1"),
+    "run/model.zip": None,
+}
 BAD_ACTIONS = {"continuous": [[NAN, 0], [INF, 0], None, "forward", [1, 2, 3], [True, False],
                               {"complex": [0.5, 1]}],
                "discrete": [NAN, INF, None, "1", 7, -1, 2.5, True]}
@@ -148,10 +168,31 @@ def run_case(case: dict, timeout: float = 60.0) -> tuple[str, str]:
     return outcome, message
 
 
+def write_policy_files(folder: str) -> None:
+    """The files of :data:`POLICY_FILES` under ``folder``."""
+    from homing_train.harness.policies import POLICY_DIR
+
+    with zipfile.ZipFile(POLICY_DIR / "ppo_procedural_fast.zip") as source:
+        data, weights = json.loads(source.read("data")), source.read("policy.pth")
+    os.makedirs(os.path.join(folder, "run"))
+    with open(os.path.join(folder, "run", "config.yml"), "w") as config:
+        config.write("env_kwargs: [1, 2\n")
+    for name, edit in POLICY_FILES.items():
+        edited = dict(data)
+        if edit is not None:
+            entry, key, value = edit
+            edited[entry] = {**data[entry], key: value}
+        with zipfile.ZipFile(os.path.join(folder, name), "w") as out:
+            out.writestr("data", json.dumps(edited))
+            out.writestr("policy.pth", weights)
+
+
 def run_command_case(case: dict, timeout: float = 120.0) -> tuple[str, str]:
     """``(outcome, message)`` of one command case (``{"module", "args"}``) in a fresh
     interpreter, its output files under a temporary folder."""
     with tempfile.TemporaryDirectory() as tmp:
+        if any(arg.removeprefix("{tmp}/") in POLICY_FILES for arg in case["args"]):
+            write_policy_files(tmp)
         args = [a.replace("{tmp}", tmp) for a in case["args"]]
         try:
             out = subprocess.run([sys.executable, "-m", case["module"], *args],

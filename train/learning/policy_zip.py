@@ -437,15 +437,15 @@ def checked_network(policy_class: type, observation_space: spaces.Space,
         parameters, activations = network_size(policy_class, observation_space, action_space,
                                                policy_kwargs)
     except Exception as err:  # the network's own checks raise many types
-        raise PolicyFileError(f"{source}: policy_kwargs {_short(policy_kwargs, 200)} build no "
+        raise PolicyFileError(f"{source}: policy_kwargs {_short(policy_kwargs, 300)} build no "
                               f"network for these spaces ({type(err).__name__}: "
                               f"{' '.join(str(err).split())[:200]})") from None
     if parameters > MAX_PARAMETERS:
-        raise PolicyFileError(f"{source}: policy_kwargs {_short(policy_kwargs, 200)} make a network "
+        raise PolicyFileError(f"{source}: policy_kwargs {_short(policy_kwargs, 300)} make a network "
                               f"of {parameters:,} parameters, more than the "
                               f"{MAX_PARAMETERS:,} allowed")
     if activations > MAX_ACTIVATIONS:
-        raise PolicyFileError(f"{source}: policy_kwargs {_short(policy_kwargs, 200)} make layers "
+        raise PolicyFileError(f"{source}: policy_kwargs {_short(policy_kwargs, 300)} make layers "
                               f"that output {activations:,} values for one observation, more "
                               f"than the {MAX_ACTIVATIONS:,} allowed")
 
