@@ -113,16 +113,17 @@ class EpisodeRecord:
 #: :class:`EpisodeRecord`'s fields that are ``None`` off a route.
 ROUTE_FIELDS = ("targets", "target_errors", "targets_finished", "targets_reached",
                 "all_targets_within_radius")
+_COUNT = 2**63 - 1           # the largest count or seed a record may hold
 #: Ranges of :class:`EpisodeRecord`'s numbers: (low, high, integer).
 RECORD_RANGES: dict[str, tuple[float, float, bool]] = {
-    "seed": (0, math.inf, True), "start_distance": (0, math.inf, False),
-    "shortest_path": (0, math.inf, False), "steps": (0, math.inf, True),
+    "seed": (0, _COUNT, True), "start_distance": (0, math.inf, False),
+    "shortest_path": (0, math.inf, False), "steps": (0, _COUNT, True),
     "path_length": (0, math.inf, False), "final_distance": (0, math.inf, False),
-    "min_distance": (0, math.inf, False), "collisions": (0, math.inf, True),
+    "min_distance": (0, math.inf, False), "collisions": (0, _COUNT, True),
     "spl": (0, 1, False), "soft_spl": (0, 1, False),
     "final_heading_error_deg": (0, 180, False), "wall_time": (0, math.inf, False),
-    "targets": (0, math.inf, True), "targets_finished": (0, math.inf, True),
-    "targets_reached": (0, math.inf, True)}
+    "targets": (0, _COUNT, True), "targets_finished": (0, _COUNT, True),
+    "targets_reached": (0, _COUNT, True)}
 
 
 def _check_numbers(name: str, value: Any, size: int | None) -> None:
