@@ -50,6 +50,18 @@ def seed_value(text: str) -> int:
     return seed
 
 
+def worker_count(text: str) -> int:
+    """``--workers``' type: an integer >= 1."""
+    try:
+        workers = int(text)
+    except ValueError:
+        workers = 0
+    if workers < 1:
+        raise argparse.ArgumentTypeError(f"a number of workers is an integer >= 1, got "
+                                         f"{text!r}")
+    return workers
+
+
 def parse_json_kwargs(text: str | None, option: str = "--env-kwargs") -> dict[str, Any]:
     """The JSON object ``text`` given to ``option`` (``{}`` for none); ``ValueError``
     naming the option otherwise."""
@@ -111,6 +123,9 @@ def import_user_module(name: str) -> None:
         importlib.import_module(name)
     except ImportError as err:
         raise ValueError(f"--import {name!r}: cannot import it ({err})") from None
+    except Exception as err:  # noqa: BLE001  (the user's module: any error is theirs)
+        raise ValueError(f"--import {name!r}: importing it failed: "
+                         f"{type(err).__name__}: {err}") from None
     listed = [m for m in os.environ.get(IMPORT_VARIABLE, "").split(",") if m]
     if name not in listed:
         os.environ[IMPORT_VARIABLE] = ",".join([*listed, name])

@@ -59,7 +59,7 @@ from tqdm import tqdm  # noqa: E402
 from homing_baselines.bearing_laws import LAWS  # noqa: E402
 from homing_baselines.bearing_sim import (ReachabilityMap, SimConfig, circumcircle,  # noqa: E402
                                    reachability_map, region)
-from homing_gym.cli import command_parser, seed_value  # noqa: E402
+from homing_gym.cli import command_parser, seed_value, worker_count  # noqa: E402
 from homing_train.figures import MEASURED_WITH  # noqa: E402
 from homing_train.harness.policies import parse_params  # noqa: E402
 from homing_train.outputs import output_dir_argument  # noqa: E402
@@ -555,28 +555,30 @@ def longrange(out: str, episodes: int = 10, seed: int = 0, route_length: float =
     success when the controller stops within 0.2 m of home) for the seeds ``seed`` ...
     ``seed + episodes - 1`` over ``workers`` processes; each episode is printed and added
     to ``longrange.json`` (in seed order) as it ends (``homing_from_m``: distance to home
-    at the end of the outbound route)."""
-    from concurrent.futures import ProcessPoolExecutor
+    at the end of the outbound route; a dead worker: see :mod:`homing_train.pool`)."""
+    import contextlib
     from functools import partial
 
     import homing_baselines
+    from homing_train.pool import pool_results
 
     os.makedirs(out, exist_ok=True)
     params = homing_baselines.make("bearing-longrange").params()
-    seeds = range(seed, seed + episodes)
+    seeds = list(range(seed, seed + episodes))
     run = partial(longrange_episode, route_length=route_length)
-    pool = ProcessPoolExecutor(workers) if workers > 1 else None
-    rows: list[dict] = []
-    for row in tqdm((pool.map if pool else map)(run, seeds), total=episodes,
-                    desc="long-range episodes", disable=not progress):
-        rows.append(row)
-        tqdm.write(json.dumps(row))
-        with open(os.path.join(out, "longrange.json"), "w") as f:
-            json.dump({"route_length": route_length, "params": params, "episodes": rows}, f,
-                      indent=1, default=str)
-    if pool:
-        pool.shutdown()
-    return rows
+    finished = (pool_results(run, seeds, workers, name=lambda s: f"seed {s}") if workers > 1
+                else ((i, run(s)) for i, s in enumerate(seeds)))
+    rows: dict[int, dict] = {}
+    with contextlib.closing(finished):
+        for i, row in tqdm(finished, total=episodes, desc="long-range episodes",
+                           disable=not progress):
+            rows[i] = row
+            tqdm.write(json.dumps(row))
+            with open(os.path.join(out, "longrange.json"), "w") as f:
+                json.dump({"route_length": route_length, "params": params,
+                           "episodes": [rows[k] for k in sorted(rows)]}, f, indent=1,
+                          default=str)
+    return [rows[k] for k in sorted(rows)]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -627,7 +629,7 @@ def main(argv: list[str] | None = None) -> int:
     lr.add_argument("--episodes", type=int, default=10)
     lr.add_argument("--seed", type=seed_value, default=0, help="seed of the first episode")
     lr.add_argument("--route-length", type=float, default=8.0, help="outbound route (m)")
-    lr.add_argument("--workers", type=int, default=1, help="processes")
+    lr.add_argument("--workers", type=worker_count, default=1, help="processes")
     lr.add_argument("--no-progress", action="store_true")
     args = parser.parse_args(argv)
     if args.command == "pixel-reachability":

@@ -51,7 +51,7 @@ import homing_gym  # noqa: E402,F401
 from homing_baselines.distance import (DistanceConfig, DistanceController,  # noqa: E402
                                        build_nest_map, distance_homing)
 from homing_baselines.warping import WarpingController, warping_homing  # noqa: E402
-from homing_gym.cli import command_parser, seed_value  # noqa: E402
+from homing_gym.cli import command_parser, seed_value, worker_count  # noqa: E402
 from homing_gym.geometry import wrap_angle  # noqa: E402
 from homing_gym.scenes.base import clearance  # noqa: E402
 from homing_gym.topdown import HOME, MapCanvas, draw_pose, draw_scene  # noqa: E402
@@ -367,7 +367,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--trials", type=int, default=100, help="episodes per distance bin")
     parser.add_argument("--episodes", type=int, default=200)
     parser.add_argument("--policy", choices=tuple(CONTROLLERS), default="distance")
-    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--workers", type=worker_count, default=2)
     parser.add_argument("--seed", type=seed_value, default=0)
     args = parser.parse_args(argv)
     try:                        # before any work: eval writes a JSON file, the others a folder

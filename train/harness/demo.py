@@ -32,6 +32,7 @@ from homing_gym.cli import (add_env_arguments, command_parser,  # noqa: E402
                             env_kwargs_from_args, seed_value)
 from homing_gym.panorama import bearing_column  # noqa: E402
 from homing_train import DEFAULT_ENV  # noqa: E402
+from homing_train.harness.evaluate import check_env_id  # noqa: E402
 from homing_train.harness.rollout import prepare_policy, rollout  # noqa: E402
 from homing_train.outputs import output_dir_argument  # noqa: E402
 
@@ -99,6 +100,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         kwargs = env_kwargs_from_args(args)
         kwargs["obs_keys"] = tuple(dict.fromkeys([*kwargs.get("obs_keys", ()), *VIEW_KEYS]))
+        check_env_id(args.env)
         env = gym.make(args.env, render_mode="rgb_array", **kwargs)
     except (ValueError, gym.error.Error) as err:
         parser.error(str(err))

@@ -22,13 +22,15 @@ from pathlib import Path
 
 from homing_gym.cli import command_parser, env_kwargs_from_args
 from homing_train.harness.evaluate import (DEFAULT_ENV, add_backend_arguments,
-                                           add_policy_arguments, evaluate,
-                                           format_summary, policy_from_args, stream_path)
+                                           add_policy_arguments, check_backend_arguments,
+                                           evaluate, format_summary, policy_from_args,
+                                           stream_path)
 from homing_train.harness.matrix import run_cell
 from homing_train.harness.policies import recorded_settings
 from homing_train.harness.protocols import PROTOCOLS, protocol
 from homing_train.outputs import (OutputLock, checked_output_dir, checked_output_file,
                                   output_file_argument, write_text_atomic)
+from homing_train.pool import WorkerDiedError, exit_status
 
 
 def _settings_folder(out: str) -> Path:
@@ -81,6 +83,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="keep the episodes already in NAME.episodes.jsonl and run the rest")
     add_backend_arguments(parser)
     args = parser.parse_args(argv)
+    check_backend_arguments(parser, args)
     try:                                # every output checked, then locked, before work
         if args.protocol:
             _settings_folder(args.out)
@@ -92,11 +95,19 @@ def main(argv: list[str] | None = None) -> int:
         parser.exit(2, f"homing-eval: error: {err}\n")
     except OSError as err:              # e.g. the disk filled while writing the result
         parser.exit(2, f"homing-eval: error: {err}\n")
-    except KeyboardInterrupt:
-        kept = (f"the settings' streams in {os.path.splitext(args.out)[0]}/" if args.protocol
-                else stream_path(args.out))
-        parser.exit(130, f"homing-eval: interrupted; the finished episodes are in {kept}: "
-                         f"the same command with --resume runs the rest\n")
+    except WorkerDiedError as err:      # killed twice, e.g. by the out-of-memory killer
+        parser.exit(1, f"homing-eval: error: {err}; the finished episodes are in "
+                       f"{_kept(args)}: the same command with --resume runs the rest\n")
+    except KeyboardInterrupt as err:    # Ctrl-C, or SIGTERM/SIGHUP while a pool runs
+        parser.exit(exit_status(err), f"homing-eval: interrupted; the finished episodes are "
+                                      f"in {_kept(args)}: the same command with --resume "
+                                      f"runs the rest\n")
+
+
+def _kept(args) -> str:
+    """Where an interrupted run's finished episodes are."""
+    return (f"the settings' streams in {os.path.splitext(args.out)[0]}/" if args.protocol
+            else stream_path(args.out))
 
 
 def _seeded_episodes(args) -> int:

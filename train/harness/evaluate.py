@@ -16,9 +16,7 @@ import dataclasses
 import inspect
 import json
 import math
-import multiprocessing as mp
 import os
-import signal
 import socket
 import time
 from dataclasses import asdict, dataclass, field
@@ -29,9 +27,9 @@ import numpy as np
 from tqdm import tqdm
 
 import homing_gym
-from homing_gym.cli import add_env_arguments, seed_value
+from homing_gym.cli import add_env_arguments, seed_value, worker_count
 from homing_gym.validation import is_real, require_number, require_positive
-from homing_gym.env import simulation_settings
+from homing_gym.env import HomingEnv, simulation_settings
 from homing_gym.paths import NoPathError, path_length, shortest_path
 from homing_gym.geometry import wrap_angle
 from homing_train import DEFAULT_ENV
@@ -41,6 +39,7 @@ from homing_train.harness.policies import (PolicySpec, parse_params, policy_spec
                                            recorded_settings)
 from homing_train.harness.rollout import prepare_policy, rollout
 from homing_train.outputs import OutputLock, atomic_path, write_text_atomic
+from homing_train.pool import pool_results
 
 SCHEMA = 1
 
@@ -378,8 +377,8 @@ _WORKER: dict[str, Any] = {}
 
 
 def _init_worker(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any]) -> None:
-    """Make the worker's env and policy. A failure is kept and raised by the first task:
-    a pool respawns workers whose initializer raises, forever."""
+    """Make the worker's env and policy. A failure is kept and raised by the first task
+    (as the task's error: a Ray actor whose constructor raises would be retried)."""
     try:
         env = gym.make(env_id, **env_kwargs)
         _WORKER["env"] = env
@@ -388,12 +387,6 @@ def _init_worker(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any]) -> N
         _WORKER["policy"] = policy
     except Exception as err:  # noqa: BLE001  (any failure: reported once, by the task)
         _WORKER["error"] = err
-
-
-def _init_pool_worker(*args) -> None:
-    """A pool worker leaves Ctrl-C to the main process, which ends the pool."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    _init_worker(*args)
 
 
 def _work(task: tuple) -> EpisodeRecord:
@@ -412,20 +405,38 @@ class _EpisodeActor:
         return _indexed_work(item)
 
 
+#: An HTTP/2 client's first bytes: the preface and an empty SETTINGS frame (RFC 9113 §3.4).
+_HTTP2_HELLO = b"PRI * HTTP/2.0\r\n\r\nSM\r\n\r\n" + bytes([0, 0, 0, 4, 0, 0, 0, 0, 0])
+
+
 def check_ray_address(address: str | None, timeout: float = 5.0) -> None:
     """``ValueError`` if ``address`` names a host and port (``HOST:PORT`` or
-    ``ray://HOST:PORT``) where nothing accepts a connection within ``timeout`` seconds:
-    Ray itself keeps retrying such an address for minutes."""
+    ``ray://HOST:PORT``) where nothing accepts a connection within ``timeout`` seconds,
+    or where what accepts it does not answer as Ray does (gRPC: an HTTP/2 SETTINGS
+    frame) within ``timeout`` seconds more: Ray itself keeps retrying such an address
+    for minutes."""
     if not address or address == "auto":
         return
     host, _, port = address.removeprefix("ray://").rpartition(":")
     if not host or not port.isdigit():
         raise ValueError(f"ray address {address!r}: expected HOST:PORT, ray://HOST:PORT or 'auto'")
     try:
-        socket.create_connection((host, int(port)), timeout=timeout).close()
+        connection = socket.create_connection((host, int(port)), timeout=timeout)
     except OSError as err:
         raise ValueError(f"ray address {address!r}: nothing answers there ({err}); 'auto' "
                          f"joins a cluster running on this machine") from None
+    with connection:
+        try:
+            connection.sendall(_HTTP2_HELLO)
+            answer = connection.recv(9)
+        except OSError:                          # socket.timeout included
+            answer = b""
+    if len(answer) < 4 or answer[3] != 4:        # the frame's type: 4 is SETTINGS
+        said = f"it said {answer[:40]!r}" if answer else "it said nothing"
+        raise ValueError(f"ray address {address!r}: something answers there, but not as "
+                         f"Ray does (no gRPC handshake in {timeout:g} s: {said}); give the "
+                         f"head node's GCS address (HOST:6379) or its Ray Client address "
+                         f"(ray://HOST:10001)")
 
 
 def _ray_records(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
@@ -442,8 +453,15 @@ def _ray_records(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
         user_modules = {k: v for k, v in os.environ.items() if k == "HOMING_GYM_IMPORT"}
         local = {} if address else {"num_cpus": workers, "object_store_memory": 200 * 2**20,
                                     "include_dashboard": False}
-        ray.init(address=address, log_to_driver=False, logging_level="ERROR",
-                 runtime_env={"env_vars": user_modules} if user_modules else None, **local)
+        try:
+            ray.init(address=address, log_to_driver=False, logging_level="ERROR",
+                     runtime_env={"env_vars": user_modules} if user_modules else None,
+                     **local)
+        except ConnectionError as err:          # e.g. 'auto' with no cluster running here
+            found = ("no Ray cluster runs on this machine" if address == "auto"
+                     else f"cannot join it ({err})")
+            raise ValueError(f"ray address {address!r}: {found}; start one with 'ray start "
+                             f"--head', or leave out --ray-address for a local Ray") from None
     actor = ray.remote(num_cpus=1)(_EpisodeActor)
     pool = ActorPool([actor.remote(spec, env_id, env_kwargs)
                       for _ in range(min(workers, len(tasks)))])
@@ -469,7 +487,10 @@ def run_episodes(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
     back in task order, the same on either backend; ``on_record`` sees each one as soon
     as it is finished (in finishing order). A policy whose episodes depend on the ones
     before (:attr:`PolicySpec.sequential`) runs them in order in this process, whatever
-    ``workers`` and ``backend`` say, so results do not depend on how episodes are split."""
+    ``workers`` and ``backend`` say, so results do not depend on how episodes are split.
+    A local worker process that dies (killed, out of memory) costs only the episodes not
+    finished: they run again in a fresh pool, and if lost again
+    :class:`homing_train.pool.WorkerDiedError` names their seeds."""
     for task in tasks:
         if not 1 <= len(task) <= 3:
             raise ValueError(f"a task is (seed, start, home), got {task!r}")
@@ -502,11 +523,11 @@ def run_episodes(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
                     env.close()
                 _WORKER.clear()
         else:
-            ctx = mp.get_context("spawn")
-            with ctx.Pool(min(workers, len(tasks)), initializer=_init_pool_worker,
-                          initargs=(spec, env_id, env_kwargs)) as pool:
-                indexed = pool.imap_unordered(_indexed_work, list(enumerate(tasks)))
-                for i, record in indexed:
+            with contextlib.closing(pool_results(
+                    _work, tasks, workers, initializer=_init_worker,
+                    initargs=(spec, env_id, env_kwargs),
+                    name=lambda task: f"seed {task[0]}")) as finished:
+                for i, record in finished:
                     records[i] = record
                     if on_record is not None:
                         on_record(record)
@@ -521,16 +542,30 @@ def _indexed_work(item: tuple[int, tuple]) -> tuple[int, EpisodeRecord]:
 
 
 def check_env_id(env_id: str) -> None:
-    """``ValueError`` naming ``env_id`` and the package's ids if Gymnasium has no such id."""
+    """``ValueError`` naming ``env_id`` and the package's ids if Gymnasium has no such id,
+    or if its entry point is a class that is no :class:`homing_gym.env.HomingEnv` (the
+    harness reads a homing env's poses, goals and scene; a factory function is trusted)."""
+    ids = list(homing_gym.ENV_IDS)
     if env_id not in gym.registry:
-        raise ValueError(f"unknown env id {env_id!r}; homing-gym ids: {list(homing_gym.ENV_IDS)}")
+        raise ValueError(f"unknown env id {env_id!r}; homing-gym ids: {ids}")
+    creator = _env_creator(env_id)
+    if isinstance(creator, type) and not issubclass(creator, HomingEnv):
+        raise ValueError(f"env {env_id!r} is not a homing-gym env ({creator.__name__} is no "
+                         f"homing_gym.env.HomingEnv): the harness scores homing episodes "
+                         f"from the robot's poses and goals; homing-gym ids: {ids}, or an "
+                         f"env of yours built on HomingEnv (--import)")
+
+
+def _env_creator(env_id: str) -> Any:
+    """What Gymnasium calls to make ``env_id``: a class or a function."""
+    entry = gym.spec(env_id).entry_point
+    return gym.envs.registration.load_env_creator(entry) if isinstance(entry, str) else entry
 
 
 def env_parameters(env_id: str) -> frozenset[str] | None:
     """The keyword arguments the entry point of ``env_id`` names, or ``None`` when it
     takes any (``**kwargs``, as homing-gym's envs do, which check the names themselves)."""
-    entry = gym.spec(env_id).entry_point
-    creator = gym.envs.registration.load_env_creator(entry) if isinstance(entry, str) else entry
+    creator = _env_creator(env_id)
     try:
         parameters = inspect.signature(creator).parameters.values()
     except (TypeError, ValueError):             # a builtin or C callable: cannot tell
@@ -727,7 +762,7 @@ def add_policy_arguments(parser: argparse.ArgumentParser,
     parser.add_argument("--seed", type=seed_value, default=None,
                         help="seed of the first episode (default 0; with --protocol: the "
                         "base seed of the protocol's episode draw, default its own)")
-    parser.add_argument("--workers", type=int, default=1, help="parallel processes")
+    parser.add_argument("--workers", type=worker_count, default=1, help="parallel processes")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--trust-policy", action="store_true",
                         help="load a model zip with pickle: RUNS CODE FROM THE FILE (only for "
@@ -742,6 +777,15 @@ def add_backend_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--ray-address", default=None, metavar="ADDRESS",
                         help="with --backend ray: the cluster to join ('auto': the running "
                         "one; default: start a local Ray)")
+
+
+def check_backend_arguments(parser: argparse.ArgumentParser,
+                            args: argparse.Namespace) -> None:
+    """``parser.error`` for ``--ray-address`` without ``--backend ray``, which would
+    ignore it."""
+    if args.ray_address is not None and args.backend != "ray":
+        parser.error(f"--ray-address {args.ray_address!r} needs --backend ray (the local "
+                     f"backend runs on this machine)")
 
 
 def policy_from_args(args: argparse.Namespace) -> PolicySpec:

@@ -41,13 +41,14 @@ from homing_gym.paths import connected  # noqa: E402
 from homing_gym.scenes.base import clearances  # noqa: E402
 from homing_gym.topdown import MapCanvas, draw_pose, draw_scale_bar, draw_scene  # noqa: E402
 from homing_train.harness.evaluate import (DEFAULT_ENV, add_policy_arguments,  # noqa: E402
-                                           policy_from_args, run_episodes)
+                                           check_env_id, policy_from_args, run_episodes)
 from homing_train.harness.palette import HOME_MARK  # noqa: E402
 from homing_train.harness.policies import PolicySpec, policy_spec  # noqa: E402
 from homing_train.harness.protocols import PROTOCOLS, protocol  # noqa: E402
 from homing_train.harness.rollout import prepare_policy, rollout  # noqa: E402
 from homing_train.outputs import (OutputLock, atomic_path,  # noqa: E402
                                   output_file_argument, write_text_atomic)
+from homing_train.pool import WorkerDiedError, exit_status  # noqa: E402
 
 # colour-blind-safe (Okabe & Ito): returned blue, not returned vermillion, unknown grey
 RETURNED, FAILED, UNKNOWN = (0, 114, 178), (213, 94, 0), (110, 110, 110)
@@ -137,6 +138,7 @@ def homing_field(policy, env_id: str = DEFAULT_ENV, grid: float = 0.2, seed: int
     if spec.kind != "controller":
         raise ValueError("homing-field needs a scripted controller that reports its home "
                          "direction (Controller.last_home_direction); SB3 models do not")
+    check_env_id(env_id)
     env_kwargs = dict(env_kwargs or {})
     env = gym.make(env_id, **env_kwargs)
     try:
@@ -246,8 +248,11 @@ def main(argv: list[str] | None = None) -> int:
             return _field(args)
     except ValueError as err:
         parser.exit(2, f"homing-field: error: {err}\n")
-    except KeyboardInterrupt:
-        parser.exit(130, f"homing-field: interrupted; {args.out} was not written\n")
+    except WorkerDiedError as err:      # killed twice, e.g. by the out-of-memory killer
+        parser.exit(1, f"homing-field: error: {err}; {args.out} was not written\n")
+    except KeyboardInterrupt as err:    # Ctrl-C, or SIGTERM/SIGHUP while a pool runs
+        parser.exit(exit_status(err), f"homing-field: interrupted; {args.out} was not "
+                                      f"written\n")
 
 
 def _field(args) -> int:

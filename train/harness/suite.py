@@ -33,16 +33,19 @@ from typing import Any
 import gymnasium as gym
 import homing_baselines
 import homing_gym  # noqa: F401  (registers the env ids)
-from homing_gym.cli import add_env_arguments, command_parser, env_kwargs_from_args, seed_value
+from homing_gym.cli import (add_env_arguments, command_parser, env_kwargs_from_args,
+                            seed_value, worker_count)
 from homing_train.extras import missing_extra
 from homing_train.harness.compare import compare
-from homing_train.harness.evaluate import (DEFAULT_ENV, add_backend_arguments, check_env_id,
+from homing_train.harness.evaluate import (DEFAULT_ENV, add_backend_arguments,
+                                           check_backend_arguments, check_env_id,
                                            evaluate, format_summary, stream_path)
 from homing_train.harness.matrix import (BASE_PERIOD, applicable, equal_time_kwargs,
                                          matrix_markdown, run_matrix)
 from homing_train.harness.policies import shipped_policies
 from homing_train.harness.protocols import PROTOCOLS, protocol
 from homing_train.outputs import OutputLock, output_dir_argument
+from homing_train.pool import WorkerDiedError, exit_status
 
 def suite_methods(env_id: str, env_kwargs: dict[str, Any] | None = None) -> list[str]:
     """The registered controllers made for ``env_id`` in the scene that ``env_kwargs``
@@ -132,7 +135,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="seed of the first episode (default 0); with --protocols the "
                         "base seed of every protocol's episode draw instead of its own (not "
                         "the canonical draw: each cell's command then carries --seed)")
-    parser.add_argument("--workers", type=int, default=2, help="parallel processes")
+    parser.add_argument("--workers", type=worker_count, default=2, help="parallel processes")
     parser.add_argument("--methods", nargs="+", help="subset of methods (default: all)")
     parser.add_argument("--success-on", choices=("stop", "reach"), default="stop",
                         help="the success rule of every row (without --protocols): stopped at "
@@ -146,8 +149,9 @@ def main(argv: list[str] | None = None) -> int:
                         "this run does not cover stay in it")
     add_backend_arguments(parser)
     args = parser.parse_args(argv)
-    if (args.episodes is not None and args.episodes < 1) or args.workers < 1:
-        parser.error("--episodes and --workers must be >= 1")
+    check_backend_arguments(parser, args)
+    if args.episodes is not None and args.episodes < 1:
+        parser.error("--episodes must be >= 1")
     if args.protocols and (args.env != DEFAULT_ENV or args.env_kwargs or args.scene):
         parser.error("--protocols fix the envs and their kwargs; drop --env/--env-kwargs/--scene")
     try:
@@ -155,10 +159,14 @@ def main(argv: list[str] | None = None) -> int:
             return _matrix(args) if args.protocols else _suite(args)
     except ValueError as err:
         parser.exit(2, f"homing-suite: error: {err}\n")
-    except KeyboardInterrupt:
-        parser.exit(130, f"homing-suite: interrupted; the finished episodes are in the "
-                         f"*.episodes.jsonl files under {args.out}/: the same command with "
-                         f"--resume runs the rest\n")
+    except WorkerDiedError as err:      # killed twice, e.g. by the out-of-memory killer
+        parser.exit(1, f"homing-suite: error: {err}; the finished episodes are in the "
+                       f"*.episodes.jsonl files under {args.out}/: the same command with "
+                       f"--resume runs the rest\n")
+    except KeyboardInterrupt as err:    # Ctrl-C, or SIGTERM/SIGHUP while a pool runs
+        parser.exit(exit_status(err), f"homing-suite: interrupted; the finished episodes are "
+                                      f"in the *.episodes.jsonl files under {args.out}/: the "
+                                      f"same command with --resume runs the rest\n")
 
 
 def _matrix(args) -> int:

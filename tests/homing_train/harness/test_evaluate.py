@@ -116,7 +116,7 @@ def test_a_controller_with_memory_runs_its_episodes_in_order_in_one_process(monk
     def no_pool(*args, **kwargs):
         raise AssertionError("a process pool was started")
 
-    monkeypatch.setattr(evaluate_module.mp, "get_context", no_pool)
+    monkeypatch.setattr(evaluate_module, "pool_results", no_pool)
     spec = policy_spec(CountingController())
     assert spec.sequential and not policy_spec("random").sequential
     result = evaluate(spec, ENV_ID, episodes=3, seed=0, env_kwargs=SHORT, workers=2,
@@ -472,10 +472,11 @@ def test_a_ray_address_where_nothing_answers_fails_at_once():
     with pytest.raises(ValueError, match="expected HOST:PORT"):
         check_ray_address("localhost")
     check_ray_address("auto")                      # left to Ray
-    with socket.socket() as server:                # something that answers
+    with socket.socket() as server:                # something that accepts, and is silent
         server.bind(("127.0.0.1", 0))
         server.listen()
-        check_ray_address(f"ray://127.0.0.1:{server.getsockname()[1]}")
+        with pytest.raises(ValueError, match="not as Ray does .* it said nothing"):
+            check_ray_address(f"ray://127.0.0.1:{server.getsockname()[1]}", timeout=1.0)
 
 
 def test_an_episode_that_passes_home_and_drives_on_is_measured_from_its_path():
