@@ -67,3 +67,21 @@ def test_a_second_writer_is_refused_and_the_lock_frees(tmp_path):
         with pytest.raises(OutputBusyError):
             OutputLock(out).acquire()
     assert os.listdir(tmp_path) == []
+
+
+def test_the_argparse_types_end_a_command_at_parse_time(tmp_path, capsys):
+    import argparse
+
+    from homing_train.outputs import output_dir_argument, output_file_argument
+
+    (tmp_path / "f.txt").write_text("x")
+    parser = argparse.ArgumentParser(prog="cmd")
+    parser.add_argument("--out", type=output_file_argument)
+    parser.add_argument("--folder", type=output_dir_argument)
+    assert parser.parse_args(["--out", "r.json"]).out == "r.json"       # the text, kept
+    for argv in (["--out", ""], ["--folder", str(tmp_path / "f.txt")]):
+        with pytest.raises(SystemExit) as end:
+            parser.parse_args(argv)
+        assert end.value.code == 2
+        last = capsys.readouterr().err.strip().splitlines()[-1]
+        assert last.startswith("cmd: error: argument") and ("empty" in last or "file" in last)
