@@ -200,8 +200,11 @@ def _checked_weights(weights: bytes, path: str) -> bytes:
     """``policy.pth``, once the torch zip it is declares at most
     :data:`MAX_WEIGHT_RECORDS` records of :data:`MAX_WEIGHTS_BYTES` bytes together."""
     what = f"{path}: policy.pth"
-    with _opened_zip(io.BytesIO(weights), MAX_WEIGHT_RECORDS, what) as records:
-        declared = sum(info.file_size for info in records.infolist())
+    try:
+        with _opened_zip(io.BytesIO(weights), MAX_WEIGHT_RECORDS, what) as records:
+            declared = sum(info.file_size for info in records.infolist())
+    except zipfile.BadZipFile as err:
+        raise PolicyFileError(f"{what}: not torch's zip format ({err})") from None
     if declared > MAX_WEIGHTS_BYTES:
         raise PolicyFileError(f"{what}: its records declare {declared:,} bytes, more than the "
                               f"{MAX_WEIGHTS_BYTES:,} allowed")
@@ -431,23 +434,26 @@ def checked_network(policy_class: type, observation_space: spaces.Space,
     _check_keys(policy_kwargs, _arguments(policy_class, 3), "policy_kwargs", source)
     extractor = policy_kwargs.get("features_extractor_class", inspect.signature(
         policy_class).parameters["features_extractor_class"].default)
+    if not isinstance(extractor, type):
+        raise PolicyFileError(f"{source}: policy_kwargs features_extractor_class must be a "
+                              f"class, got {_short(extractor)}")
     _check_keys(policy_kwargs.get("features_extractor_kwargs") or {},
                 _arguments(extractor, 1), "policy_kwargs features_extractor_kwargs", source)
+    given = f"policy_kwargs {_short(policy_kwargs, 300)}"
     try:
         parameters, activations = network_size(policy_class, observation_space, action_space,
                                                policy_kwargs)
     except Exception as err:  # the network's own checks raise many types
-        raise PolicyFileError(f"{source}: policy_kwargs {_short(policy_kwargs, 300)} build no "
-                              f"network for these spaces ({type(err).__name__}: "
-                              f"{' '.join(str(err).split())[:200]})") from None
+        raise PolicyFileError(f"{source}: {given} build no network for these spaces "
+                              f"({type(err).__name__}: {' '.join(str(err).split())[:200]})"
+                              ) from None
     if parameters > MAX_PARAMETERS:
-        raise PolicyFileError(f"{source}: policy_kwargs {_short(policy_kwargs, 300)} make a network "
-                              f"of {parameters:,} parameters, more than the "
-                              f"{MAX_PARAMETERS:,} allowed")
+        raise PolicyFileError(f"{source}: {given} make a network of {parameters:,} "
+                              f"parameters, more than the {MAX_PARAMETERS:,} allowed")
     if activations > MAX_ACTIVATIONS:
-        raise PolicyFileError(f"{source}: policy_kwargs {_short(policy_kwargs, 300)} make layers "
-                              f"that output {activations:,} values for one observation, more "
-                              f"than the {MAX_ACTIVATIONS:,} allowed")
+        raise PolicyFileError(f"{source}: {given} make layers that output {activations:,} "
+                              f"values for one observation, more than the "
+                              f"{MAX_ACTIVATIONS:,} allowed")
 
 
 def stored_policy(data: dict, path: str) -> StoredPolicy:

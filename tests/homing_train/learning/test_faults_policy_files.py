@@ -132,6 +132,8 @@ def test_zip_directory_and_member_sizes_are_checked_before_reading(tmp_path, mon
             out.writestr(f"archive/data/{i}", b"")
     with pytest.raises(PolicyFileError, match=r"policy.pth: .*more than the"):
         load_policy(crafted_zip(tmp_path, "records.zip", weights=records.getvalue()))
+    with pytest.raises(PolicyFileError, match=r"policy.pth: not torch's zip format"):
+        load_policy(crafted_zip(tmp_path, "legacy.zip", weights=b"\x80\x02}q\x00."))
     path = crafted_zip(tmp_path, "plain.zip")
     monkeypatch.setattr(policy_zip, "MAX_DATA_BYTES", 1000)
     with pytest.raises(PolicyFileError, match=r"member 'data' declares [\d,]+ bytes, more "
