@@ -161,7 +161,7 @@ def test_eval_cli_rejects_bad_input(tmp_path, capsys, argv, message):
 @pytest.mark.parametrize("argv, message", [
     (["--env-kwargs", '{"bogus": 1}'], "unknown keyword arguments ['bogus']"),
     (["--env-kwargs", '{"scene": "moon"}'], "unknown scene 'moon'"),
-    (["--workers", "0"], "workers must be >= 1"),
+    (["--workers", "0"], "a number of workers is an integer >= 1"),
     (["--bin-width", "-1"], "bin width must be a positive number"),
     (["--seed", "-5"], "a seed is an integer >= 0"),
 ])
