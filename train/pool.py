@@ -15,6 +15,7 @@ into a closed pipe.
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import multiprocessing as mp
 import signal
@@ -22,7 +23,7 @@ import threading
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed, wait
 from concurrent.futures.process import BrokenProcessPool
-from typing import Any
+from typing import Any, NoReturn
 
 _FAILED: list[BaseException] = []          # in a worker: its initializer's error
 
@@ -46,10 +47,15 @@ class Stopped(KeyboardInterrupt):
         self.status = 128 + signum
 
 
-def exit_status(interrupt: KeyboardInterrupt) -> int:
-    """The exit status of a command ended by ``interrupt``: 130 for Ctrl-C (SIGINT),
-    128 + the signal number for :class:`Stopped`."""
-    return getattr(interrupt, "status", 128 + signal.SIGINT)
+def end_stopped_command(parser: argparse.ArgumentParser, stop: BaseException,
+                        kept: str) -> NoReturn:
+    """End a command that ``stop`` ended with one line saying so and ``kept`` (what
+    became of its work): status 1 for :class:`WorkerDiedError`, 130 for Ctrl-C, 128 +
+    the signal for :class:`Stopped`."""
+    if isinstance(stop, WorkerDiedError):
+        parser.exit(1, f"{parser.prog}: error: {stop}; {kept}\n")
+    parser.exit(getattr(stop, "status", 128 + signal.SIGINT),
+                f"{parser.prog}: interrupted; {kept}\n")
 
 
 def _start_worker(initializer: Callable[..., None] | None, initargs: tuple) -> None:

@@ -30,7 +30,7 @@ from homing_train.harness.policies import recorded_settings
 from homing_train.harness.protocols import PROTOCOLS, protocol
 from homing_train.outputs import (OutputLock, checked_output_dir, checked_output_file,
                                   output_file_argument, write_text_atomic)
-from homing_train.pool import WorkerDiedError, exit_status
+from homing_train.pool import WorkerDiedError, end_stopped_command
 
 
 def _settings_folder(out: str) -> Path:
@@ -95,19 +95,11 @@ def main(argv: list[str] | None = None) -> int:
         parser.exit(2, f"homing-eval: error: {err}\n")
     except OSError as err:              # e.g. the disk filled while writing the result
         parser.exit(2, f"homing-eval: error: {err}\n")
-    except WorkerDiedError as err:      # killed twice, e.g. by the out-of-memory killer
-        parser.exit(1, f"homing-eval: error: {err}; the finished episodes are in "
-                       f"{_kept(args)}: the same command with --resume runs the rest\n")
-    except KeyboardInterrupt as err:    # Ctrl-C, or SIGTERM/SIGHUP while a pool runs
-        parser.exit(exit_status(err), f"homing-eval: interrupted; the finished episodes are "
-                                      f"in {_kept(args)}: the same command with --resume "
-                                      f"runs the rest\n")
-
-
-def _kept(args) -> str:
-    """Where an interrupted run's finished episodes are."""
-    return (f"the settings' streams in {os.path.splitext(args.out)[0]}/" if args.protocol
-            else stream_path(args.out))
+    except (WorkerDiedError, KeyboardInterrupt) as err:   # Ctrl-C, SIGTERM, SIGHUP too
+        kept = (f"the settings' streams in {os.path.splitext(args.out)[0]}/" if args.protocol
+                else stream_path(args.out))
+        end_stopped_command(parser, err, f"the finished episodes are in {kept}: the same "
+                                         f"command with --resume runs the rest")
 
 
 def _seeded_episodes(args) -> int:

@@ -48,7 +48,7 @@ from homing_train.harness.protocols import PROTOCOLS, protocol  # noqa: E402
 from homing_train.harness.rollout import prepare_policy, rollout  # noqa: E402
 from homing_train.outputs import (OutputLock, atomic_path,  # noqa: E402
                                   output_file_argument, write_text_atomic)
-from homing_train.pool import WorkerDiedError, exit_status  # noqa: E402
+from homing_train.pool import WorkerDiedError, end_stopped_command  # noqa: E402
 
 # colour-blind-safe (Okabe & Ito): returned blue, not returned vermillion, unknown grey
 RETURNED, FAILED, UNKNOWN = (0, 114, 178), (213, 94, 0), (110, 110, 110)
@@ -248,11 +248,8 @@ def main(argv: list[str] | None = None) -> int:
             return _field(args)
     except ValueError as err:
         parser.exit(2, f"homing-field: error: {err}\n")
-    except WorkerDiedError as err:      # killed twice, e.g. by the out-of-memory killer
-        parser.exit(1, f"homing-field: error: {err}; {args.out} was not written\n")
-    except KeyboardInterrupt as err:    # Ctrl-C, or SIGTERM/SIGHUP while a pool runs
-        parser.exit(exit_status(err), f"homing-field: interrupted; {args.out} was not "
-                                      f"written\n")
+    except (WorkerDiedError, KeyboardInterrupt) as err:   # Ctrl-C, SIGTERM, SIGHUP too
+        end_stopped_command(parser, err, f"{args.out} was not written")
 
 
 def _field(args) -> int:

@@ -45,7 +45,7 @@ from homing_train.harness.matrix import (BASE_PERIOD, applicable, equal_time_kwa
 from homing_train.harness.policies import shipped_policies
 from homing_train.harness.protocols import PROTOCOLS, protocol
 from homing_train.outputs import OutputLock, output_dir_argument
-from homing_train.pool import WorkerDiedError, exit_status
+from homing_train.pool import WorkerDiedError, end_stopped_command
 
 def suite_methods(env_id: str, env_kwargs: dict[str, Any] | None = None) -> list[str]:
     """The registered controllers made for ``env_id`` in the scene that ``env_kwargs``
@@ -159,14 +159,10 @@ def main(argv: list[str] | None = None) -> int:
             return _matrix(args) if args.protocols else _suite(args)
     except ValueError as err:
         parser.exit(2, f"homing-suite: error: {err}\n")
-    except WorkerDiedError as err:      # killed twice, e.g. by the out-of-memory killer
-        parser.exit(1, f"homing-suite: error: {err}; the finished episodes are in the "
-                       f"*.episodes.jsonl files under {args.out}/: the same command with "
-                       f"--resume runs the rest\n")
-    except KeyboardInterrupt as err:    # Ctrl-C, or SIGTERM/SIGHUP while a pool runs
-        parser.exit(exit_status(err), f"homing-suite: interrupted; the finished episodes are "
-                                      f"in the *.episodes.jsonl files under {args.out}/: the "
-                                      f"same command with --resume runs the rest\n")
+    except (WorkerDiedError, KeyboardInterrupt) as err:   # Ctrl-C, SIGTERM, SIGHUP too
+        end_stopped_command(parser, err, f"the finished episodes are in the *.episodes.jsonl "
+                                         f"files under {args.out}/: the same command with "
+                                         f"--resume runs the rest")
 
 
 def _matrix(args) -> int:
