@@ -432,6 +432,8 @@ class HomingEnv(gym.Env):
     # -- Gymnasium API --------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         self._check_open()
+        if isinstance(seed, (bool, np.bool_)):     # an int to Python, not a seed
+            raise ValueError(f"seed must be an integer >= 0 or None, got {seed!r}")
         super().reset(seed=seed)
         # a randomised scene draws a new world on a seeded reset and every
         # episodes_per_world unseeded ones (building a procedural world costs tens of ms)

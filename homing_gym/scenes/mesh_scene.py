@@ -429,8 +429,9 @@ def parse_mesh_spec(spec: str) -> tuple[str, MeshOptions]:
                 what = (f"option {field!r} has no name" if field else
                         "an empty option (nothing between '?' or '&' and the next '&' or "
                         "the end)")
-                raise ValueError(f"{what}: write mesh:PATH?option=value&option=value, "
-                                 f"e.g. mesh:PATH?scale=0.01&up=y")
+                raise ValueError(f"{what}: write options as key=value joined by '&', "
+                                 f"mesh:PATH?option=value&option=value, e.g. "
+                                 f"mesh:PATH?scale=0.01&up=y")
             _check_option_name(key)
             if not equals:
                 raise ValueError(f"option {key!r} has no value: write {key}=VALUE")

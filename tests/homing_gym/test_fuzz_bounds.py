@@ -114,3 +114,10 @@ def test_mesh_worlds_far_from_the_origin_or_mistyped_are_refused(tmp_path, query
 def test_a_folder_given_as_a_mesh_is_called_a_folder(tmp_path):
     with pytest.raises(ValueError, match="is a directory, not a mesh file"):
         gym.make("homing_gym/LocalHoming-v0", scene=f"mesh:{tmp_path}", **SMALL)
+
+
+def test_a_boolean_seed_is_refused():
+    env = gym.make("homing_gym/LocalHoming-v0", **SMALL)
+    with pytest.raises(ValueError, match="seed must be an integer >= 0 or None, got True"):
+        env.reset(seed=True)
+    env.close()
