@@ -18,11 +18,13 @@ from __future__ import annotations
 import argparse
 import contextlib
 import multiprocessing as mp
+import os
 import signal
 import threading
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed, wait
 from concurrent.futures.process import BrokenProcessPool
+from multiprocessing import connection
 from typing import Any, NoReturn
 
 _FAILED: list[BaseException] = []          # in a worker: its initializer's error
@@ -61,13 +63,23 @@ def end_stopped_command(parser: argparse.ArgumentParser, stop: BaseException,
 def _start_worker(initializer: Callable[..., None] | None, initargs: tuple) -> None:
     """A worker ignores Ctrl-C (inherited from its start already) and keeps its
     initializer's error for its tasks to raise: an executor whose initializer raises
-    is broken, which would read as a worker death."""
+    is broken, which would read as a worker death. It ends when the main process does,
+    even by SIGKILL, rather than wait for tasks for ever."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    parent = mp.parent_process()
+    if parent is not None:
+        threading.Thread(target=_exit_with, args=(parent.sentinel,), daemon=True).start()
     if initializer is not None:
         try:
             initializer(*initargs)
         except Exception as err:  # noqa: BLE001  (any failure: raised by the tasks)
             _FAILED.append(err)
+
+
+def _exit_with(parent_sentinel: int) -> None:
+    """End this worker at once when the process behind ``parent_sentinel`` ends."""
+    connection.wait([parent_sentinel])
+    os._exit(1)
 
 
 def _call(fn: Callable[[Any], Any], item: Any) -> Any:

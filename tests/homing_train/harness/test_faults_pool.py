@@ -64,6 +64,22 @@ def test_sighup_ends_the_pool_as_ctrl_c_does():
     assert _workers_of(os.getpid()) == []
 
 
+def test_workers_end_when_the_main_process_is_killed():
+    """``kill -9`` of the main process leaves no worker waiting for tasks for ever."""
+    main = subprocess.Popen([sys.executable, "-c", "from homing_train.pool import "
+                             "pool_results; list(pool_results(eval, "
+                             "['__import__(\"time\").sleep(60)'] * 2, 2))"])
+    try:
+        _wait_for(lambda: len(_workers_of(main.pid)) == 2, main, timeout=60)
+        workers = _workers_of(main.pid)
+        main.kill()
+        main.wait()
+        gone, alive = psutil.wait_procs(workers, timeout=30)
+    finally:
+        main.kill()
+    assert alive == []
+
+
 EVAL = [sys.executable, "-m", "homing_train.harness.eval_command", "--policy", "warping",
         "--workers", "2", "--quiet", "--env-kwargs",
         '{"panorama_shape": [16, 64], "max_episode_steps": 120}']
