@@ -110,6 +110,12 @@ def _raise_stopped(signum: int, frame) -> None:
     raise Stopped(signum)
 
 
+def stop_on_signals() -> contextlib.AbstractContextManager:
+    """SIGTERM and SIGHUP raise :class:`Stopped` in the block (a ``with`` block or a
+    decorated function), so that it ends as on Ctrl-C, keeping what finished."""
+    return _signals({signal.SIGTERM: _raise_stopped, signal.SIGHUP: _raise_stopped})
+
+
 def _ending(exit_codes: Sequence[int | None]) -> str:
     """How the dead worker ended, from every worker's exit code (the pool ends the
     others with SIGTERM)."""
@@ -182,7 +188,7 @@ def pool_results(fn: Callable[[Any], Any], items: Sequence[Any], workers: int,
     if workers < 1:
         raise ValueError(f"workers must be >= 1, got {workers}")
     todo, pools, ending = list(range(len(items))), 0, ""
-    with _signals({signal.SIGTERM: _raise_stopped, signal.SIGHUP: _raise_stopped}):
+    with stop_on_signals():
         while todo:
             if pools > retries:
                 raise WorkerDiedError([name(items[i]) for i in todo], ending, pools)

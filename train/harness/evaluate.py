@@ -39,7 +39,7 @@ from homing_train.harness.policies import (PolicySpec, parse_params, policy_spec
                                            recorded_settings)
 from homing_train.harness.rollout import prepare_policy, rollout
 from homing_train.outputs import OutputLock, atomic_path, write_text_atomic
-from homing_train.pool import pool_results
+from homing_train.pool import pool_results, stop_on_signals
 
 SCHEMA = 1
 
@@ -475,6 +475,7 @@ def _ray_records(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
 BACKENDS = ("local", "ray")
 
 
+@stop_on_signals()
 def run_episodes(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
                  tasks: Sequence[tuple], workers: int = 1,
                  progress: bool = True, desc: str = "episodes",
@@ -490,7 +491,8 @@ def run_episodes(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
     ``workers`` and ``backend`` say, so results do not depend on how episodes are split.
     A local worker process that dies (killed, out of memory) costs only the episodes not
     finished: they run again in a fresh pool, and if lost again
-    :class:`homing_train.pool.WorkerDiedError` names their seeds."""
+    :class:`homing_train.pool.WorkerDiedError` names their seeds. SIGTERM and SIGHUP end
+    the run as Ctrl-C does (:class:`homing_train.pool.Stopped`)."""
     for task in tasks:
         if not 1 <= len(task) <= 3:
             raise ValueError(f"a task is (seed, start, home), got {task!r}")

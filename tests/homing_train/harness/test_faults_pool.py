@@ -81,13 +81,15 @@ def test_workers_end_when_the_main_process_is_killed():
 
 
 EVAL = [sys.executable, "-m", "homing_train.harness.eval_command", "--policy", "warping",
-        "--workers", "2", "--quiet", "--env-kwargs",
+        "--quiet", "--env-kwargs",
         '{"panorama_shape": [16, 64], "max_episode_steps": 120}']
 
 
-def _start(tmp_path, episodes: int, **popen) -> tuple[subprocess.Popen, str]:
+def _start(tmp_path, episodes: int, workers: int = 2,
+           **popen) -> tuple[subprocess.Popen, str]:
     out = str(tmp_path / "w.json")
-    process = subprocess.Popen([*EVAL, "--episodes", str(episodes), "--out", out],
+    process = subprocess.Popen([*EVAL, "--episodes", str(episodes), "--workers", str(workers),
+                                "--out", out],
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                **popen)
     return process, str(tmp_path / "w.episodes.jsonl")
@@ -136,11 +138,13 @@ def test_killing_a_worker_of_homing_eval_loses_no_episode(tmp_path):
 
 
 @pytest.mark.slow
-def test_sigterm_to_homing_eval_ends_it_with_one_line_and_no_worker_traceback(tmp_path):
+@pytest.mark.parametrize("workers", [2, 1])
+def test_sigterm_to_homing_eval_ends_it_with_one_line_and_no_worker_traceback(tmp_path,
+                                                                               workers):
     """SIGTERM to the main process: it used to die at once, its orphaned workers then
     printing tracebacks into the closed pipe; now it ends the pool, keeps the finished
-    episodes and says so in one line (status 143)."""
-    process, stream = _start(tmp_path, 40)
+    episodes and says so in one line (status 143), with or without workers."""
+    process, stream = _start(tmp_path, 40, workers)
     try:
         _wait_for(lambda: _records(stream) >= 1, process)
         workers = _workers_of(process.pid)
