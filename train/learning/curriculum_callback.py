@@ -11,6 +11,7 @@ from pathlib import Path
 from stable_baselines3.common.callbacks import BaseCallback
 
 from homing_train.learning.curriculum import HOOK, CurriculumSettings
+from homing_train.outputs import write_text_atomic
 
 
 class CurriculumCallback(BaseCallback):
@@ -48,8 +49,8 @@ class CurriculumCallback(BaseCallback):
             self.history.append({"stage": stage,
                                  "start_distance": list(self.settings.start_distance[stage]),
                                  **extra, "from_step": int(self.num_timesteps)})
-        self.path.write_text(json.dumps({"settings": self.settings.as_dict(),
-                                         "stages": self.history}, indent=2))
+        write_text_atomic(self.path, json.dumps({"settings": self.settings.as_dict(),
+                                                 "stages": self.history}, indent=2))
 
     def _on_training_start(self) -> None:
         self._enter(self.stage)

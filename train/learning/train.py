@@ -30,6 +30,8 @@ import sys
 import tempfile
 import time
 import traceback
+import zipfile
+import zlib
 from dataclasses import asdict, dataclass, field, fields
 from functools import partial
 from importlib import resources
@@ -53,6 +55,7 @@ from homing_train.learning.thread_split import phase_threads
 from homing_train.learning.ppo_settings import (PPO_KEYS, check_device, check_ppo,
                                                extractor_arguments, ppo_arguments)
 from homing_train.learning.pretrain import pretrain
+from homing_train.outputs import OutputLock, atomic_path, checked_output_dir, write_text_atomic
 
 HYPERPARAMS = Path(str(resources.files("homing_train.learning") / "hyperparams" / "ppo.yml"))
 EVAL_SEED_OFFSET = 1_000_000
@@ -96,6 +99,10 @@ def check_seed_ranges(config: "TrainConfig", done_steps: int = 0) -> None:
                                  f"would train on worlds it evaluates on; use fewer steps")
 
 
+def _integer(value: Any) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
 @dataclass
 class TrainConfig:
     """Everything that defines a run (written to ``config.yml``)."""
@@ -129,12 +136,12 @@ class TrainConfig:
     ppo: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        if self.env_id not in gym.registry:     # homing-gym's ids, or a user's (--import)
+        if not isinstance(self.env_id, str) or self.env_id not in gym.registry:     # homing-gym's ids, or a user's (--import)
             raise ValueError(f"unknown env {self.env_id!r}; homing-gym ids: "
                              f"{list(homing_gym.ENV_IDS)} (or register yours, --import MODULE)")
         if self.vec not in ("subproc", "dummy"):
             raise ValueError(f"--vec must be 'subproc' or 'dummy', got {self.vec!r}")
-        if self.workers is not None and not (isinstance(self.workers, int)
+        if self.workers is not None and not (_integer(self.workers)
                                              and 1 <= self.workers <= self.n_envs):
             raise ValueError(f"workers must be an integer from 1 to n_envs ({self.n_envs}), "
                              f"got {self.workers!r}")
@@ -142,18 +149,25 @@ class TrainConfig:
             raise ValueError(f"unknown extractor {self.extractor!r}; allowed: {EXTRACTORS}")
         for key in ("timesteps", "n_envs", "eval_freq", "eval_episodes", "checkpoint_freq",
                     "torch_threads", "imitation_episodes", "imitation_epochs",
-                    "pretrain_positions", "pretrain_scenes"):
+                    "pretrain_positions", "pretrain_scenes", "features_dim"):
             value = getattr(self, key)
-            if not (isinstance(value, int) and value >= 1):
+            if not (_integer(value) and value >= 1):
                 raise ValueError(f"{key} must be an integer >= 1, got {value!r}")
-        for key in ("imitation_iterations", "pretrain_samples", "critic_warmup_steps"):
+        for key in ("seed", "imitation_iterations", "pretrain_samples", "critic_warmup_steps"):
             value = getattr(self, key)
-            if not (isinstance(value, int) and value >= 0):
+            if not (_integer(value) and value >= 0):
                 raise ValueError(f"{key} must be an integer >= 0, got {value!r}")
+        for key in ("env_kwargs", "ppo"):
+            if not isinstance(getattr(self, key), dict):
+                raise ValueError(f"{key} must be a mapping, got {getattr(self, key)!r}")
+        if not isinstance(self.device, str):
+            raise ValueError(f"device must be a torch device name, e.g. 'cpu', got "
+                             f"{self.device!r}")
         rate = self.warm_start_learning_rate
         if not (isinstance(rate, (int, float)) and math.isfinite(rate) and rate > 0):
             raise ValueError(f"warm_start_learning_rate must be a positive number, got {rate!r}")
-        if self.init_policy is not None and not Path(self.init_policy).is_file():
+        if self.init_policy is not None and not (isinstance(self.init_policy, str)
+                                                 and Path(self.init_policy).is_file()):
             raise ValueError(f"init_policy {self.init_policy!r} is not a file (give a saved "
                              f"stable-baselines3 PPO .zip)")
         if not isinstance(self.eval_deterministic, bool):
@@ -365,10 +379,33 @@ def checkpoint_steps(path: Path) -> int:
     return int(match.group(1))
 
 
-def latest_checkpoint(run: Path) -> Path | None:
-    """The checkpoint with the most steps in ``run/checkpoints``, if any."""
-    found = [(checkpoint_steps(p), p) for p in (run / "checkpoints").glob("ppo_*_steps.zip")]
-    return max(found)[1] if found else None
+def model_zip_fault(path: Path) -> str | None:
+    """Why the saved model at ``path`` cannot be loaded whole (a save torn by a kill or a
+    full disk), or ``None`` when it is a zip holding SB3's ``data`` and ``policy.pth``
+    whose every member reads back with its checksum."""
+    try:
+        with zipfile.ZipFile(path) as archive:
+            bad = archive.testzip()
+            missing = sorted({"data", "policy.pth"} - set(archive.namelist()))
+    except (OSError, EOFError, ValueError, zlib.error, zipfile.BadZipFile) as err:
+        return f"{type(err).__name__}: {err}"
+    if bad is not None:
+        return f"its member {bad!r} is damaged"
+    return f"no {missing} in it (not a stable-baselines3 save)" if missing else None
+
+
+def latest_checkpoint(run: Path, torn: list[tuple[Path, str]] | None = None) -> Path | None:
+    """The intact checkpoint with the most steps in ``run/checkpoints``, if any; the
+    newer torn ones passed over are appended to ``torn`` as ``(path, why)``."""
+    found = sorted(((int(m.group(1)), p) for p in (run / "checkpoints").glob("ppo_*_steps.zip")
+                    if (m := re.fullmatch(r"ppo_(\d+)_steps\.zip", p.name))), reverse=True)
+    for _, path in found:
+        fault = model_zip_fault(path)
+        if fault is None:
+            return path
+        if torn is not None:
+            torn.append((path, fault))
+    return None
 
 
 def plot_learning_curve(run: Path) -> Path | None:
@@ -414,7 +451,8 @@ def plot_learning_curve(run: Path) -> Path | None:
     mark_stages(ax, stages)
     ax.set_title(f"{run.name}: evaluation on held-out seeds")
     out = run / "learning_curve.png"
-    fig.savefig(out, dpi=100)
+    with atomic_path(out) as tmp:
+        fig.savefig(tmp, dpi=100, format="png")
     plt.close(fig)
     return out
 
@@ -424,13 +462,34 @@ def _restore_evaluations(callback, run: Path) -> None:
     path = run / "evaluations.npz"
     if not path.is_file():
         return
-    data = np.load(path)
-    callback.evaluations_timesteps = list(data["timesteps"])
-    callback.evaluations_results = [list(r) for r in data["results"]]
-    callback.evaluations_length = [list(r) for r in data["ep_lengths"]]
-    callback.evaluations_successes = [list(r) for r in data.get("successes", [])]
-    if len(data["results"]):
-        callback.best_mean_reward = float(np.max(np.mean(data["results"], axis=1)))
+    try:
+        with np.load(path) as data:
+            steps, results, lengths = (list(data[key]) for key in
+                                       ("timesteps", "results", "ep_lengths"))
+            successes = list(data["successes"]) if "successes" in data else []
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as err:
+        raise ValueError(f"{path} cannot be read ({type(err).__name__}: {err}): move it "
+                         f"aside to resume without the earlier evaluations") from err
+    callback.evaluations_timesteps = steps
+    callback.evaluations_results = [list(r) for r in results]
+    callback.evaluations_length = [list(r) for r in lengths]
+    callback.evaluations_successes = [list(r) for r in successes]
+    if results:
+        callback.best_mean_reward = float(np.max(np.mean(results, axis=1)))
+
+
+def previous_sessions(summary: Path) -> list[dict]:
+    """The training sessions recorded in a run's ``summary.json`` (none without one)."""
+    if not summary.is_file():
+        return []
+    try:
+        sessions = json.loads(summary.read_text())["sessions"]
+    except (OSError, ValueError, KeyError, TypeError) as err:
+        raise ValueError(f"{summary} cannot be read ({type(err).__name__}: {err}): move it "
+                         f"aside to resume without the earlier sessions' record") from err
+    if not isinstance(sessions, list):
+        raise ValueError(f"{summary}: 'sessions' must be a list, got {sessions!r}")
+    return sessions
 
 
 def _raise_interrupt(signum, frame) -> None:
@@ -523,9 +582,10 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
           command: str | None = None, progress: bool = True):
     """Train (or, with ``resume``, continue) a run in folder ``out``; returns the model."""
     from stable_baselines3 import PPO
-    from stable_baselines3.common.callbacks import CheckpointCallback, EvalCallback
     import torch
 
+    from homing_train.learning.checkpoints import (AtomicCheckpointCallback, AtomicEvalCallback,
+                                                   save_model)
     from homing_train.learning.curriculum_callback import CurriculumCallback
 
     # One intra-op thread by default: with the env workers on the same cores, torch's
@@ -548,11 +608,12 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
     done_steps = checkpoint_steps(checkpoint) if checkpoint is not None else 0
     check_seed_ranges(config, done_steps)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "config.yml").write_text(yaml.safe_dump(asdict(config), sort_keys=False))
-    with open(out / "command.txt", "a") as f:
-        # the installed command's name, not this machine's path to it
-        f.write((command or shlex.join(["homing-train", *sys.argv[1:]])) + "\n")
-    (out / "versions.json").write_text(json.dumps(versions(), indent=2))
+    write_text_atomic(out / "config.yml", yaml.safe_dump(asdict(config), sort_keys=False))
+    commands = out / "command.txt"
+    # the installed command's name, not this machine's path to it
+    write_text_atomic(commands, (commands.read_text() if commands.is_file() else "")
+                      + (command or shlex.join(["homing-train", *sys.argv[1:]])) + "\n")
+    write_text_atomic(out / "versions.json", json.dumps(versions(), indent=2))
     report_dir = Path(tempfile.mkdtemp(prefix="homing-train-workers-"))
     env = make_vec(config, config.n_envs, config.seed + done_steps, report_dir)
     eval_env = make_vec(TrainConfig(**{**asdict(config), "vec": "dummy"}), config.n_scenes,
@@ -571,18 +632,17 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
                 for group in model.policy.optimizer.param_groups:
                     group["lr"] = config.warm_start_learning_rate
                 record = warm_start(model)
-                (out / f"{name}.json").write_text(json.dumps(asdict(record), indent=2))
-                model.save(out / f"{name}_model.zip")
+                write_text_atomic(out / f"{name}.json", json.dumps(asdict(record), indent=2))
+                save_model(model, out / f"{name}_model.zip")
         start_steps = model.num_timesteps
         remaining = config.timesteps - start_steps
-        eval_cb = EvalCallback(eval_env, n_eval_episodes=config.eval_episodes,
-                               eval_freq=max(config.eval_freq // config.n_envs, 1),
-                               log_path=str(out), best_model_save_path=str(out),
-                               deterministic=config.eval_deterministic, verbose=0)
+        eval_cb = AtomicEvalCallback(eval_env, out, n_eval_episodes=config.eval_episodes,
+                                     eval_freq=max(config.eval_freq // config.n_envs, 1),
+                                     deterministic=config.eval_deterministic, verbose=0)
         if checkpoint is not None:
             _restore_evaluations(eval_cb, out)
-        ckpt_cb = CheckpointCallback(max(config.checkpoint_freq // config.n_envs, 1),
-                                     str(out / "checkpoints"), name_prefix="ppo")
+        ckpt_cb = AtomicCheckpointCallback(max(config.checkpoint_freq // config.n_envs, 1),
+                                           str(out / "checkpoints"), name_prefix="ppo")
         callbacks = [eval_cb, ckpt_cb, phase_threads(config.torch_threads)]
         if curriculum is not None:     # a resumed run goes on at the stage it had reached
             stage, history = (last_stage(out / "curriculum.json") if checkpoint is not None
@@ -617,17 +677,16 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
             signal.signal(signal.SIGTERM, previous_term)
         set_actor_trainable(model.policy, True)
         wall = time.perf_counter() - t0
-        model.save(out / "model.zip")
+        save_model(model, out / "model.zip")
         if interrupted:                     # --resume continues from here
-            model.save(out / "checkpoints" / f"ppo_{model.num_timesteps}_steps.zip")
+            save_model(model, out / "checkpoints" / f"ppo_{model.num_timesteps}_steps.zip")
         summary_path = out / "summary.json"
-        previous = json.loads(summary_path.read_text()) if summary_path.is_file() else {}
-        sessions = previous.get("sessions", []) + [{
+        sessions = previous_sessions(summary_path) + [{
             "from_step": int(start_steps), "to_step": int(model.num_timesteps),
             "wall_time_s": round(wall, 1),
             "env_steps_per_s": round((model.num_timesteps - start_steps) / max(wall, 1e-9), 1)}]
         total_wall = sum(s["wall_time_s"] for s in sessions)
-        summary_path.write_text(json.dumps({
+        write_text_atomic(summary_path, json.dumps({
             "timesteps": int(model.num_timesteps), "wall_time_s": round(total_wall, 1),
             "env_steps_per_s": round(sum(s["to_step"] - s["from_step"] for s in sessions)
                                      / max(total_wall, 1e-9), 1),
@@ -676,6 +735,47 @@ def _benchmark(parser, config: TrainConfig, steps: int) -> int:
     except (ValueError, EnvWorkerError) as err:
         parser.exit(2, f"homing-train: error: {err}\n")
     return 0
+
+
+def saved_config(run: Path, timesteps: int | None = None) -> TrainConfig:
+    """The config of the run in folder ``run`` (its ``config.yml``, read as plain YAML
+    data), with ``timesteps`` instead of its own if given; ``ValueError`` naming the file
+    and the bad field otherwise."""
+    path = run / "config.yml"
+    if not path.is_file():
+        raise ValueError(f"--resume {run}: no config.yml there (not a run folder)")
+    try:
+        saved = yaml.safe_load(path.read_text())
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as err:
+        raise ValueError(f"{path} is not readable YAML: {' '.join(str(err).split())}") from err
+    names = [f.name for f in fields(TrainConfig)]
+    if not isinstance(saved, dict):
+        raise ValueError(f"{path} must map the run's settings {names}, got "
+                         f"{type(saved).__name__}")
+    unknown = sorted(str(key) for key in set(saved) - set(names))
+    if unknown or "env_id" not in saved:
+        raise ValueError(f"{path}: " + (f"unknown fields {unknown}; allowed: {names}"
+                                        if unknown else "no env_id field"))
+    try:
+        return TrainConfig(**{**saved, **({"timesteps": timesteps} if timesteps else {})})
+    except ValueError as err:
+        raise ValueError(f"{path}: {err}") from err
+
+
+def resume_checkpoint(run: Path, config: TrainConfig) -> Path:
+    """The newest intact checkpoint of ``run``, saying on stderr which newer ones are torn
+    and skipped; ``ValueError`` when there is none."""
+    torn: list[tuple[Path, str]] = []
+    checkpoint = latest_checkpoint(run, torn)
+    for path, why in torn:
+        print(f"homing-train: warning: skipping torn checkpoint {path} ({why})",
+              file=sys.stderr)
+    if checkpoint is None:             # starting over would overwrite model.zip
+        raise ValueError(f"--resume {run}: no {'intact ' if torn else ''}checkpoint in "
+                         f"{run / 'checkpoints'} to continue from (one is saved every "
+                         f"checkpoint_freq = {config.checkpoint_freq} steps and when a run "
+                         f"is interrupted); start a new run with another --out")
+    return checkpoint
 
 
 def starting_settings(parser, args) -> tuple[str, dict[str, Any]]:
@@ -727,23 +827,15 @@ def main(argv: list[str] | None = None) -> int:
         require_extra("train", "homing-train")
     except MissingExtraError as err:
         parser.exit(2, f"homing-train: error: {err}\n")
-    if args.resume and args.recipe:
+    if args.resume is not None and args.recipe:
         parser.error("--resume continues a run with its saved config; --recipe starts a new "
                      "one: use one")
+    if args.resume is not None and args.out is not None:
+        parser.error("--resume continues the run in its own folder; --out is not used with it")
     try:
-        if args.resume:
-            run = Path(args.resume)
-            if not (run / "config.yml").is_file():
-                raise ValueError(f"--resume {run}: no config.yml there (not a run folder)")
-            saved = yaml.safe_load((run / "config.yml").read_text())
-            if args.timesteps:
-                saved["timesteps"] = args.timesteps
-            config = TrainConfig(**saved)
-            if latest_checkpoint(run) is None:    # starting over would overwrite model.zip
-                raise ValueError(f"--resume {run}: no checkpoint in {run / 'checkpoints'} to "
-                                 f"continue from (one is saved every checkpoint_freq = "
-                                 f"{config.checkpoint_freq} steps and when a run is "
-                                 f"interrupted); start a new run with another --out")
+        if args.resume is not None:
+            run = Path(checked_output_dir(args.resume, "--resume"))
+            config = saved_config(run, args.timesteps)
         else:
             env_id, settings = starting_settings(parser, args)
             settings.update(parse_overrides(args.hp))
@@ -756,16 +848,27 @@ def main(argv: list[str] | None = None) -> int:
             config = make_config(env_id, settings, seed=args.seed, timesteps=args.timesteps,
                                  n_envs=args.n_envs, vec=args.vec, device=args.device,
                                  extractor=args.extractor, env_kwargs=args.env_kwargs)
-            run = Path(args.out or f"runs/{config.env_id.split('/')[-1]}_{config.extractor}"
-                                   f"_s{config.seed}")
+            if args.benchmark is None:
+                run = Path(checked_output_dir(
+                    f"runs/{config.env_id.split('/')[-1]}_{config.extractor}_s{config.seed}"
+                    if args.out is None else args.out, "--out"))
     except ValueError as err:
         parser.error(str(err))
     if args.benchmark is not None:
         return _benchmark(parser, config, args.benchmark)
     try:
-        train(config, run, resume=bool(args.resume), progress=not args.no_progress)
+        with OutputLock(run):           # a second homing-train on this folder is refused
+            if args.resume is not None:
+                resume_checkpoint(run, config)
+            elif run.is_dir() and any(run.iterdir()):
+                raise ValueError(f"--out {run} already holds files (an earlier run?): "
+                                 f"continue it with --resume {run}, or choose another --out")
+            train(config, run, resume=args.resume is not None, progress=not args.no_progress)
     except (ValueError, EnvWorkerError) as err:
         parser.exit(2, f"homing-train: error: {err}\n")
+    except OSError as err:          # a full disk, say: every save made before it is whole
+        parser.exit(1, f"homing-train: error: {err}; the checkpoints saved before it are "
+                       f"whole: homing-train --resume {run} continues from the last\n")
     summary = json.loads((run / "summary.json").read_text())
     if summary.get("interrupted"):
         print(f"interrupted at step {summary['timesteps']}: model.zip, a checkpoint and "
