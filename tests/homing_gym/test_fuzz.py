@@ -81,6 +81,13 @@ BAD_COMMANDS = [   # (module of the command, arguments)
     ("homing_train.learning.train", ["--env", "nope/Nope-v0", "--out", "{tmp}/run"]),
     ("homing_train.learning.train", ["--timesteps", "-5", "--out", "{tmp}/run"]),
     ("homing_train.learning.train", ["--hp", "n_stepz=64", "--out", "{tmp}/run"]),
+    # homing-train's run folder and settings: checked before any work
+    ("homing_train.learning.train", ["--out", "", "--timesteps", "64"]),
+    ("homing_train.learning.train", ["--out", "/proc/none/run", "--timesteps", "64"]),
+    ("homing_train.learning.train", ["--out", "/dev/null", "--timesteps", "64"]),
+    ("homing_train.learning.train", ["--resume", "{tmp}"]),
+    ("homing_train.learning.train", ["--resume", "{tmp}", "--out", "{tmp}/run"]),
+    ("homing_train.learning.train", ["--hp", "policy_kwargs={nope: 1}", "--out", "{tmp}/run"]),
     ("homing_gym.benchmark", ["--steps", "0"]),
     # worker counts, backends and envs that cannot run (tests/.../test_faults_pool.py: the
     # pool's faults, broken --import modules, Ray addresses that are not Ray)
