@@ -145,10 +145,10 @@ class Simulator:
             self.client.changeVisualShape(body, -1, rgbaColor=[1, 1, 1, 0])
 
     def _make_part(self, part: MeshPart, band: tuple[float, float]) -> list[int]:
-        """Bodies of a mesh part: one static concave collision body of its triangles that
-        reach into ``band`` (if it collides and any do), and, where PyBullet draws,
-        one visual body (no collision) per face colour (colours rounded to 1/16: a
-        PyBullet mesh takes one colour)."""
+        """Bodies of a mesh part: static concave collision bodies of its triangles that
+        reach into ``band`` (if it collides and any do; one per :data:`MAX_SHAPE_FACES`),
+        and, where PyBullet draws, visual bodies (no collision) of each face colour
+        (colours rounded to 1/16: a PyBullet mesh takes one colour)."""
         c, bodies = self.client, []
         faces = part.faces[band_faces(part, band)] if part.collision else part.faces[:0]
         for chunk in _face_chunks(part.vertices, faces) if len(faces) else ():

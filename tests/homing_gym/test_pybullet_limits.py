@@ -93,3 +93,14 @@ def test_memory_stays_flat_over_300_procedural_worlds():
     curve = memory_curve("random_nature", worlds=300, every=50, panorama_shape=(16, 64))
     growth = curve[-1][1] - curve[1][1]          # after 50 worlds of warm-up
     assert growth < 12, f"resident memory grew {growth:.1f} MiB over 250 worlds: {curve}"
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--scene", "arena"], "not procedural"), (["--scene", "nowhere"], "--scene"),
+    (["--worlds", "0"], "--worlds"), (["--every", "500", "--worlds", "100"], "--every")])
+def test_memory_check_refuses_bad_arguments_in_one_line(capsys, args, words):
+    from homing_gym.memory_check import main
+    with pytest.raises(SystemExit) as exit_:
+        main(args)
+    error = capsys.readouterr().err
+    assert exit_.value.code == 2 and words in error and "Traceback" not in error
