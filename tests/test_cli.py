@@ -30,6 +30,7 @@ COMMANDS = {
     "python -m homing_gym.scenes.mesh_example": "homing_gym.scenes.mesh_example",
     "python -m homing_gym.scenes.tussocks": "homing_gym.scenes.tussocks",
     "python -m homing_gym.freespace": "homing_gym.freespace",
+    "python -m homing_gym.memory_check": "homing_gym.memory_check",
 }
 
 
