@@ -8,9 +8,9 @@ run again in a fresh pool, once by default; lost a second time, they end the run
 handed out stay valid: items are seeded, so a rerun gives the same result.
 
 Workers ignore Ctrl-C from the moment they start, importing included (the main process
-ends the pool), and SIGTERM or SIGHUP to the main process while a pool runs ends it as
-Ctrl-C does (:class:`Stopped`), so that no worker is left running to print tracebacks
-into a closed pipe.
+ends the pool), and end with the main process, even a killed one. SIGTERM or SIGHUP to
+the main process while a pool runs ends it as Ctrl-C does (:class:`Stopped`), so that
+no worker is left running to print tracebacks into a closed pipe.
 """
 
 from __future__ import annotations
@@ -36,13 +36,14 @@ class WorkerDiedError(RuntimeError):
     def __init__(self, lost: Sequence[str], ending: str, pools: int):
         self.lost = list(lost)
         shown = ", ".join(self.lost[:20]) + (", ..." if len(self.lost) > 20 else "")
-        super().__init__(f"a worker process died ({ending}) in each of {pools} pools; "
+        super().__init__(f"a worker process died ({ending}), {pools} times in a row; "
                          f"{len(self.lost)} not finished: {shown}")
 
 
 class Stopped(KeyboardInterrupt):
-    """SIGTERM or SIGHUP to the main process while a pool ran, raised as Ctrl-C's
-    ``KeyboardInterrupt`` is; ``status`` is the exit status for it, 128 + the signal."""
+    """SIGTERM or SIGHUP to the main process (in :func:`stop_on_signals`), raised as
+    Ctrl-C's ``KeyboardInterrupt`` is; ``status`` is the exit status for it, 128 + the
+    signal."""
 
     def __init__(self, signum: int):
         super().__init__(f"stopped by {signal.Signals(signum).name}")
