@@ -54,7 +54,16 @@ def _workers_of(pid: int) -> list[psutil.Process]:
             if "spawn_main" in " ".join(c.cmdline())]
 
 
-def test_sighup_ends_the_pool_as_ctrl_c_does():
+@pytest.fixture
+def sighup_handled():
+    """SIGHUP handled (by doing nothing) in this test run, whatever it was before: the
+    pool leaves a SIGHUP that a run ignores (``nohup``) ignored."""
+    previous = signal.signal(signal.SIGHUP, lambda signum, frame: None)
+    yield
+    signal.signal(signal.SIGHUP, previous)
+
+
+def test_sighup_ends_the_pool_as_ctrl_c_does(sighup_handled):
     """SIGHUP (a closed terminal) or SIGTERM to the main process while a pool runs raises
     :class:`Stopped` there (exit status 128 + the signal) and ends the workers."""
     threading.Timer(3.0, os.kill, (os.getpid(), signal.SIGHUP)).start()
