@@ -89,6 +89,19 @@ def test_workers_end_when_the_main_process_is_killed():
     assert alive == []
 
 
+def test_a_hangup_that_the_run_ignores_stays_ignored():
+    """Under ``nohup`` (SIGHUP ignored) a closed terminal must not stop the run."""
+    from homing_train.pool import stop_on_signals
+
+    previous = signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    try:
+        with stop_on_signals():
+            assert signal.getsignal(signal.SIGHUP) is signal.SIG_IGN
+            assert signal.getsignal(signal.SIGTERM) not in (signal.SIG_DFL, signal.SIG_IGN)
+    finally:
+        signal.signal(signal.SIGHUP, previous)
+
+
 EVAL = [sys.executable, "-m", "homing_train.harness.eval_command", "--policy", "warping",
         "--quiet", "--env-kwargs",
         '{"panorama_shape": [16, 64], "max_episode_steps": 120}']
