@@ -51,6 +51,12 @@ BAD_KWARGS = [
     {"drive": "tank"}, {"drive": "synchro", "action_type": "discrete"},
     {"panorama_shape": 48}, {"sky_color": 5}, {"camera_height": "0.3"}, {"bogus": 1},
     {"max_speed": 1e9}, {"supersampling": True}, {"obs_keys": "panorama"},
+    {"success_radius": 1e6}, {"n_targets": 10**9}, {"n_targets": True},
+    {"episodes_per_world": True}, {"episodes_per_world": 10**30}, {"physics_substeps": True},
+    {"odometry_noise": 1e9}, {"spacing": 1e-9}, {"start_jitter": [0.05, 1e9]},
+    {"n_views": 6.0}, {"goal_step_length": NAN}, {"camera_height": INF}, {"vfov_deg": NAN},
+    {"max_speed": True}, {"scene": "mesh:room.obj?&&"},
+    {"scene": "mesh:room.obj?scale=1&scale=2"}, {"scene": "mesh:/"},
 ]
 BAD_COMMANDS = [   # (module of the command, arguments)
     ("homing_train.harness.eval_command", ["--policy", "nope", "--out", "{tmp}/r.json"]),
@@ -179,8 +185,9 @@ except Exception as err:
 """
 
 
-def cases(n_kwargs: int = 60, seed: int = 0) -> list[dict]:
-    """A seeded sample of constructor cases over the env ids, and every bad action."""
+def cases(n_kwargs: int | None = None, seed: int = 0) -> list[dict]:
+    """A seeded sample of ``n_kwargs`` constructor cases (default: all) over the env ids,
+    and every bad action."""
     rng = np.random.default_rng(seed)
     out = [{"env_id": ENV_IDS[int(rng.integers(len(ENV_IDS)))],
             "kwargs": BAD_KWARGS[int(i)]}
