@@ -454,7 +454,8 @@ def _ray_records(spec: PolicySpec, env_id: str, env_kwargs: dict[str, Any],
         local = {} if address else {"num_cpus": workers, "object_store_memory": 200 * 2**20,
                                     "include_dashboard": False}
         try:
-            ray.init(address=address, log_to_driver=False, logging_level="ERROR",
+            ray.init(address=address or "local",   # never a cluster found by chance
+                     log_to_driver=False, logging_level="ERROR",
                      runtime_env={"env_vars": user_modules} if user_modules else None,
                      **local)
         except ConnectionError as err:          # e.g. 'auto' with no cluster running here

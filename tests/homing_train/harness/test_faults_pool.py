@@ -222,7 +222,7 @@ def test_a_ray_cluster_passes_the_address_check():
 
     from homing_train.harness.evaluate import check_ray_address
 
-    ray.init(num_cpus=1, include_dashboard=False, log_to_driver=False)
+    ray.init(address="local", num_cpus=1, include_dashboard=False, log_to_driver=False)
     try:
         check_ray_address(ray.get_runtime_context().gcs_address)
     finally:
