@@ -27,6 +27,9 @@ from concurrent.futures.process import BrokenProcessPool
 from multiprocessing import connection
 from typing import Any, NoReturn
 
+#: The most worker processes a pool starts per CPU core.
+WORKERS_PER_CORE = 4
+
 _FAILED: list[BaseException] = []          # in a worker: its initializer's error
 
 
@@ -180,14 +183,18 @@ def pool_results(fn: Callable[[Any], Any], items: Sequence[Any], workers: int,
                  ) -> Iterator[tuple[int, Any]]:
     """``(index, fn(items[index]))`` for every item, in finishing order, from
     ``min(workers, len(items))`` spawned processes that each run
-    ``initializer(*initargs)`` first (if it raises, their tasks raise its error). ``fn``
-    and the items must pickle. Items lost to a dead worker run again in a fresh pool, up
+    ``initializer(*initargs)`` first (if it raises, their tasks raise its error);
+    ``workers`` is at most :data:`WORKERS_PER_CORE` per CPU core. ``fn`` and the items
+    must pickle. Items lost to a dead worker run again in a fresh pool, up
     to ``retries`` times; then :class:`WorkerDiedError` names them (by ``name(item)``).
     A task's own error is raised as itself and ends the pool, as Ctrl-C does; SIGTERM
     and SIGHUP raise :class:`Stopped` while the pool runs. Close the generator
     (``contextlib.closing``) to end the pool when stopping early."""
-    if workers < 1:
-        raise ValueError(f"workers must be >= 1, got {workers}")
+    cores = os.cpu_count() or 1
+    if not 1 <= workers <= WORKERS_PER_CORE * cores:
+        raise ValueError(f"workers must be from 1 to {WORKERS_PER_CORE * cores} here "
+                         f"({WORKERS_PER_CORE} per CPU core, {cores} cores: more only share "
+                         f"the cores, each holding its own env in memory), got {workers}")
     todo, pools, ending = list(range(len(items))), 0, ""
     with stop_on_signals():
         while todo:

@@ -48,6 +48,13 @@ def test_a_task_error_and_an_initializer_error_are_raised_as_themselves():
         list(pool_results(eval, ["1", "2"], 2, initializer=int, initargs=("x",)))
 
 
+def test_more_workers_than_the_machine_can_use_are_refused_before_any_starts():
+    cores = os.cpu_count()
+    with pytest.raises(ValueError, match=f"from 1 to {4 * cores} here .*{cores} cores"):
+        next(pool_results(eval, ["1"] * 2, 4 * cores + 1))
+    assert _workers_of(os.getpid()) == []
+
+
 def _workers_of(pid: int) -> list[psutil.Process]:
     """The spawned pool workers among ``pid``'s children."""
     return [c for c in psutil.Process(pid).children()
