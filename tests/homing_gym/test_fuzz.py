@@ -94,6 +94,8 @@ BAD_COMMANDS = [   # (module of the command, arguments)
     ("homing_train.learning.train", ["--resume", "{tmp}"]),
     ("homing_train.learning.train", ["--resume", "{tmp}", "--out", "{tmp}/run"]),
     ("homing_train.learning.train", ["--hp", "policy_kwargs={nope: 1}", "--out", "{tmp}/run"]),
+    ("homing_train.learning.train", ["--hp", "policy_kwargs={net_arch: [1000000000]}",
+                                     "--n-envs", "1", "--vec", "dummy", "--out", "{tmp}/run"]),
     ("homing_gym.benchmark", ["--steps", "0"]),
     # worker counts, backends and envs that cannot run (tests/.../test_faults_pool.py: the
     # pool's faults, broken --import modules, Ray addresses that are not Ray)

@@ -558,6 +558,29 @@ def check_curriculum(env: gym.Env, curriculum: CurriculumSettings) -> None:
             raise ValueError(f"curriculum stage {i}: {err}") from err
 
 
+def check_memory(config: TrainConfig, observation_space: gym.Space) -> None:
+    """``ValueError`` when the run's rollout buffer (``n_steps`` x ``n_envs`` observations
+    as float32) or its policy's MLP after the extractor (float32 weights, gradients and
+    Adam's two moments: 16 bytes a parameter) need more than this machine's memory."""
+    memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    n_steps = config.ppo.get("n_steps", 2048)
+    values = gym.spaces.flatdim(observation_space)
+    rollout = 4 * n_steps * config.n_envs * values
+    arch = config.ppo.get("policy_kwargs", {}).get("net_arch", [64, 64])
+    heads = list(arch.values()) if isinstance(arch, dict) else [arch, arch]
+    parameters = sum(a * b for widths in heads
+                     for a, b in zip([config.features_dim, *widths], widths))
+    for need, what, fix in (
+            (rollout, f"the rollout buffer (n_steps {n_steps} x n_envs {config.n_envs} x "
+                      f"{values} observation values x 4 bytes)", "fewer n_steps or n_envs"),
+            (16 * parameters, f"the policy's MLP (net_arch {arch} after features_dim "
+                              f"{config.features_dim}: {parameters} parameters x 16 bytes)",
+             "narrower layers")):
+        if need > memory:
+            raise ValueError(f"{what} needs {need / 2**30:.1f} GiB, more than this machine's "
+                             f"{memory / 2**30:.1f} GiB of memory; use {fix}")
+
+
 def new_model(config: TrainConfig, env, **kwargs):
     """A fresh PPO model of ``config`` on the vectorised ``env`` (``kwargs``: more PPO
     arguments, e.g. ``tensorboard_log``)."""
@@ -603,6 +626,7 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
     if curriculum is not None:
         check_curriculum(made, curriculum)
     probe.close()
+    check_memory(config, probe.observation_space)
     checkpoint = latest_checkpoint(out) if resume else None
     # a resumed run draws new training episodes: its envs are seeded past the steps done
     done_steps = checkpoint_steps(checkpoint) if checkpoint is not None else 0
@@ -725,6 +749,7 @@ def _benchmark(parser, config: TrainConfig, steps: int) -> int:
         env = make_vec(config, config.n_envs, config.seed)
         try:
             env.action_space.seed(config.seed)
+            check_memory(config, env.observation_space)
             model = new_model(config, env)
             if config.init_policy:      # a trained policy's episodes, not a random one's
                 load_policy_weights(model, config.init_policy)
