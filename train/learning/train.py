@@ -632,6 +632,8 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
     done_steps = checkpoint_steps(checkpoint) if checkpoint is not None else 0
     check_seed_ranges(config, done_steps)
     out.mkdir(parents=True, exist_ok=True)
+    for stale in (*out.glob(".*.tmp"), *out.glob("checkpoints/.*.tmp")):
+        stale.unlink()          # the temporary of a save cut by a kill (the run is locked)
     write_text_atomic(out / "config.yml", yaml.safe_dump(asdict(config), sort_keys=False))
     commands = out / "command.txt"
     # the installed command's name, not this machine's path to it

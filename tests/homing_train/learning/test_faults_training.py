@@ -9,6 +9,7 @@ import pytest
 import torch
 import yaml
 
+from homing_train.learning.checkpoints import save_model
 from homing_train.learning.train import latest_checkpoint, main
 from homing_train.outputs import OutputLock
 
@@ -78,6 +79,8 @@ def test_resume_with_every_checkpoint_torn_is_one_clear_error(tmp_path, capsys):
 
 def test_a_save_cut_by_a_full_disk_keeps_the_old_file_and_leaves_no_temporary(
         tmp_path, monkeypatch, capsys):
+    from stable_baselines3 import PPO
+
     run = tmp_path / "run"
     main(["--timesteps", "128", "--out", str(run), *TINY])
     kept = {p.name: p.read_bytes() for p in (run / "checkpoints").iterdir()}
@@ -89,6 +92,9 @@ def test_a_save_cut_by_a_full_disk_keeps_the_old_file_and_leaves_no_temporary(
         raise OSError(errno.ENOSPC, "No space left on device")
 
     monkeypatch.setattr(torch, "save", save_then_fill_the_disk)
+    with pytest.raises(OSError, match="No space left"):        # an overwrite cut short
+        save_model(PPO.load(run / "model.zip"), run / "model.zip")
+    assert (run / "model.zip").read_bytes() == model
     with pytest.raises(SystemExit) as exit_:        # the first save of the resumed run fails
         main(["--resume", str(run), "--timesteps", "384", "--no-progress"])
     assert exit_.value.code == 1
@@ -175,3 +181,33 @@ def test_a_bad_config_yml_on_resume_names_the_file_and_the_field(tmp_path, capsy
     line = error_line(capsys)
     assert message in line and str(tmp_path / "config.yml") in line
     assert not (tmp_path / "ran").exists()
+
+
+KILLED_MID_SAVE = """
+import os, signal, sys, torch
+from homing_train.learning.train import main
+real_save, checkpoints = torch.save, os.path.join(sys.argv[1], "checkpoints")
+def save_then_die(obj, f, *args, **kwargs):    # SIGKILL inside the save of ppo_256
+    real_save(obj, f, *args, **kwargs)
+    if any(n.startswith(".ppo_256_steps.zip.") for n in os.listdir(checkpoints)):
+        os.kill(os.getpid(), signal.SIGKILL)
+torch.save = save_then_die
+main(["--timesteps", "256", "--out", sys.argv[1], *sys.argv[2:]])
+"""
+
+
+def test_a_run_killed_mid_save_resumes_from_its_last_whole_checkpoint(tmp_path, capsys):
+    import subprocess
+    import sys
+
+    run = tmp_path / "run"
+    killed = subprocess.run([sys.executable, "-c", KILLED_MID_SAVE, str(run), *TINY],
+                            capture_output=True, text=True, timeout=300)
+    assert killed.returncode == -9, killed.stderr
+    assert sorted(p.name for p in (run / "checkpoints").iterdir() if not p.name.startswith(
+        ".")) == ["ppo_128_steps.zip"]
+    assert [p for p in (run / "checkpoints").iterdir() if p.name.endswith(".tmp")]
+    assert main(["--resume", str(run), "--timesteps", "256", "--no-progress"]) == 0
+    assert "warning" not in capsys.readouterr().err
+    assert latest_checkpoint(run).name == "ppo_256_steps.zip"
+    assert not [p for p in run.rglob("*.tmp")]
