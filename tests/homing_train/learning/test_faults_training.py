@@ -146,9 +146,11 @@ def test_a_second_homing_train_on_a_busy_run_folder_is_refused(tmp_path, capsys)
     (["--hp", "policy_kwargs={net_arch: [8], nope: 1}", "--out", "{tmp}/run"],
      "unknown policy_kwargs ['nope']; allowed: ['net_arch',"),
     ([*TINY, "--hp", "policy_kwargs={net_arch: [1000000000]}", "--out", "{tmp}/run"],
-     "64000000000 parameters x 16 bytes) needs 953.7 GiB, more than this machine's"),
+     "64000000000 parameters x 16 bytes) would take 953.7 GiB, more than this machine's"),
     ([*TINY, "--hp", "n_steps=1000000000", "--out", "{tmp}/run"],
-     "(n_steps 1000000000 x n_envs 1 x 13824 observation values x 4 bytes) needs"),
+     "(n_steps 1000000000 x n_envs 1 x 13824 observation values x 4 bytes) would take"),
+    ([*TINY, "--n-envs", "2000", "--vec", "subproc", "--out", "{tmp}/run"],
+     "2000 env worker processes (--vec subproc, about 300 MiB each) would take 585.9 GiB"),
 ])
 def test_bad_run_folders_and_settings_are_one_clear_error(tmp_path, capsys, argv, message):
     with pytest.raises(SystemExit) as exit_:
