@@ -216,13 +216,17 @@ def load_hyperparams(env_id: str, path: Path = HYPERPARAMS) -> dict[str, Any]:
     """The ``default`` entry of a YAML hyperparameter file updated by ``env_id``'s entry."""
     try:
         table = yaml.safe_load(Path(path).read_text()) or {}
-    except (OSError, yaml.YAMLError) as err:
-        raise ValueError(f"cannot read hyperparameter file {path}: {err}") from err
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as err:
+        raise ValueError(f"cannot read hyperparameter file {path}: "
+                         f"{' '.join(str(err).split())}") from err
     if not isinstance(table, dict):
         raise ValueError(f"hyperparameter file {path} must map env ids to settings")
-    merged = dict(table.get("default") or {})
-    merged.update(table.get(env_id) or {})
-    return merged
+    entries = {key: table.get(key) or {} for key in ("default", env_id)}
+    for key, entry in entries.items():
+        if not isinstance(entry, dict):
+            raise ValueError(f"hyperparameter file {path}: {key!r} must map setting names "
+                             f"to values, got {entry!r}")
+    return {**entries["default"], **entries[env_id]}
 
 
 def recipe(name: str, folder: Path | None = None) -> tuple[str, dict[str, Any]]:
@@ -907,8 +911,10 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, EnvWorkerError) as err:
         parser.exit(2, f"homing-train: error: {err}\n")
     except OSError as err:          # a full disk, say: every save made before it is whole
-        parser.exit(1, f"homing-train: error: {err}; the checkpoints saved before it are "
-                       f"whole: homing-train --resume {run} continues from the last\n")
+        kept = latest_checkpoint(run)
+        parser.exit(1, f"homing-train: error: {err}" + (
+            f"; the saves before it are whole: homing-train --resume {run} continues from "
+            f"{kept.name}" if kept else "") + "\n")
     summary = json.loads((run / "summary.json").read_text())
     if summary.get("interrupted"):
         print(f"interrupted at step {summary['timesteps']}: model.zip, a checkpoint and "

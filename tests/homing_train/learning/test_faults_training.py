@@ -99,7 +99,7 @@ def test_a_save_cut_by_a_full_disk_keeps_the_old_file_and_leaves_no_temporary(
         main(["--resume", str(run), "--timesteps", "384", "--no-progress"])
     assert exit_.value.code == 1
     line = error_line(capsys)
-    assert "No space left on device" in line and "--resume" in line
+    assert "No space left on device" in line and "continues from ppo_128_steps.zip" in line
     assert {p.name: p.read_bytes() for p in (run / "checkpoints").iterdir()} == kept
     assert (run / "model.zip").read_bytes() == model
     assert not [p for p in run.rglob("*") if p.name.startswith(".")]     # no temporaries
@@ -155,6 +155,22 @@ def test_a_second_homing_train_on_a_busy_run_folder_is_refused(tmp_path, capsys)
 def test_bad_run_folders_and_settings_are_one_clear_error(tmp_path, capsys, argv, message):
     with pytest.raises(SystemExit) as exit_:
         main([a.replace("{tmp}", str(tmp_path)) for a in argv])
+    assert exit_.value.code == 2
+    assert message in error_line(capsys)
+    assert not (tmp_path / "run").exists()
+
+
+@pytest.mark.parametrize("text, message", [
+    ("default: {policy_kwargs: {net_arch: [8], nope: 1}}",
+     "unknown policy_kwargs ['nope']; allowed: ['net_arch',"),
+    ("homing_gym/LocalHoming-v0: [n_steps, 64]", "'homing_gym/LocalHoming-v0' must map "
+                                                 "setting names to values, got ['n_steps', 64]"),
+    ("default: {n_steps: [unclosed", "cannot read hyperparameter file"),
+])
+def test_a_bad_hyperparameter_file_is_one_clear_error(tmp_path, capsys, text, message):
+    (tmp_path / "ppo.yml").write_text(text)
+    with pytest.raises(SystemExit) as exit_:
+        main(["--hyperparams", str(tmp_path / "ppo.yml"), "--out", str(tmp_path / "run")])
     assert exit_.value.code == 2
     assert message in error_line(capsys)
     assert not (tmp_path / "run").exists()
