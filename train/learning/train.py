@@ -822,6 +822,13 @@ def resume_checkpoint(run: Path, config: TrainConfig) -> Path:
     return checkpoint
 
 
+def resume_hint(run: Path) -> str:
+    """How to continue ``run`` after a failure, when it has an intact checkpoint."""
+    kept = latest_checkpoint(run)
+    return (f"; the saves before it are whole: homing-train --resume {run} continues from "
+            f"{kept.name}" if kept else "")
+
+
 def starting_settings(parser, args) -> tuple[str, dict[str, Any]]:
     """The env id and settings ``--hp`` and the flags start from: ``--recipe``'s, else the
     hyperparameter file's for ``--env``."""
@@ -911,10 +918,9 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, EnvWorkerError) as err:
         parser.exit(2, f"homing-train: error: {err}\n")
     except OSError as err:          # a full disk, say: every save made before it is whole
-        kept = latest_checkpoint(run)
-        parser.exit(1, f"homing-train: error: {err}" + (
-            f"; the saves before it are whole: homing-train --resume {run} continues from "
-            f"{kept.name}" if kept else "") + "\n")
+        parser.exit(1, f"homing-train: error: {err}{resume_hint(run)}\n")
+    except KeyboardInterrupt:       # outside learn() (which keeps its work): in a save, say
+        parser.exit(130, f"homing-train: interrupted{resume_hint(run)}\n")
     summary = json.loads((run / "summary.json").read_text())
     if summary.get("interrupted"):
         print(f"interrupted at step {summary['timesteps']}: model.zip, a checkpoint and "

@@ -229,3 +229,29 @@ def test_a_run_killed_mid_save_resumes_from_its_last_whole_checkpoint(tmp_path, 
     assert "warning" not in capsys.readouterr().err
     assert latest_checkpoint(run).name == "ppo_256_steps.zip"
     assert not [p for p in run.rglob("*.tmp")]
+
+
+def test_ctrl_c_in_the_final_save_keeps_the_old_model_and_says_how_to_resume(
+        tmp_path, monkeypatch, capsys):
+    from homing_train.learning import checkpoints
+
+    run = tmp_path / "run"
+    main(["--timesteps", "128", "--out", str(run), *TINY])
+    model = (run / "model.zip").read_bytes()
+    real_save = checkpoints.save_model
+
+    def interrupted_at_model_zip(model, path):
+        if path.name == "model.zip":
+            with checkpoints.atomic_path(str(path)) as tmp:
+                open(tmp, "wb").write(b"PK half a zip")
+                raise KeyboardInterrupt
+        real_save(model, path)
+
+    monkeypatch.setattr(checkpoints, "save_model", interrupted_at_model_zip)
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as exit_:
+        main(["--resume", str(run), "--timesteps", "256", "--no-progress"])
+    assert exit_.value.code == 130
+    assert error_line(capsys).endswith("continues from ppo_256_steps.zip")
+    assert (run / "model.zip").read_bytes() == model
+    assert not list(run.glob(".*.tmp"))
