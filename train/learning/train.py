@@ -13,6 +13,11 @@ success rates), ``checkpoints/``, ``config.yml``, ``command.txt``, ``versions.js
 ``summary.json`` (timesteps, wall time, env steps per second of ``learn()``),
 TensorBoard logs in ``tb/`` and ``learning_curve.png``; with a ``curriculum``,
 ``curriculum.json`` (the stages reached and when).
+
+A new run needs a new or empty ``--out`` (an existing run is continued with ``--resume``),
+and a run folder has one ``homing-train`` at a time. Every save is atomic (a temporary
+file renamed over the old one), so a kill or a full disk never leaves a torn file;
+``--resume`` continues from the newest intact checkpoint, skipping a torn one (a warning).
 """
 
 from __future__ import annotations
