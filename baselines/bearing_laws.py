@@ -15,7 +15,7 @@ snapshot), and the bisector of ``L_i A L_j`` measured in the current snapshot, s
 * the two snapshots do **not** need a common frame: the paper's law is compass-free
   (abstract, §7), and rotating all goal bearings by a constant changes nothing;
 * the motion vector is returned in the frame of the *current* bearings (the robot frame,
-  e.g. counter-clockwise from the heading as in :mod:`homing_gym.panorama`).
+  e.g. counter-clockwise from the heading as in :mod:`homing_gym.render.panorama`).
 
 A caller whose snapshots are aligned (a compass, or the 2-D simulator's world frame) can
 of course use them as is; only :func:`snapshots_similar` with ``aligned=True`` needs that.

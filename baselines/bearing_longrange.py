@@ -78,7 +78,7 @@ from homing_baselines.bearing_laws import UnifiedLaw
 from homing_baselines.klt import CornerTracker, KLTConfig
 from homing_baselines.motion import Move
 from homing_gym.geometry import wrap_angle
-from homing_gym.panorama import column_bearing
+from homing_gym.render.panorama import column_bearing
 
 
 @dataclass(frozen=True)

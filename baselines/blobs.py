@@ -5,7 +5,7 @@ The paper tracks three coloured posters with a Bayesian colour classifier and ta
 bearing of each blob's centroid; landmark identity is the colour. We segment each colour
 with an OpenCV HSV box (:class:`BlobColor`), keep the largest 8-connected component of
 each colour (at least ``min_area`` pixels) and convert the centroid column ``x`` into a
-bearing with the panorama convention of :mod:`homing_gym.panorama`:
+bearing with the panorama convention of :mod:`homing_gym.render.panorama`:
 ``beta = pi - 2*pi*x/W`` (radians, counter-clockwise from the heading).
 
 **The seam.** The panorama's left and right edges (``x = 0`` and ``x = W``, straight
@@ -28,7 +28,7 @@ import cv2
 import numpy as np
 
 from homing_gym.geometry import wrap_angle
-from homing_gym.panorama import column_bearing
+from homing_gym.render.panorama import column_bearing
 
 
 @dataclass(frozen=True)

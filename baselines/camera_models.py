@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from homing_gym.panorama import column_bearing, row_elevation
+from homing_gym.render.panorama import column_bearing, row_elevation
 
 
 class CameraModel(ABC):
@@ -43,7 +43,7 @@ class CameraModel(ABC):
 
 @dataclass(frozen=True)
 class PanoramaModel(CameraModel):
-    """The env's cylindrical panorama (``homing_gym.panorama``): ``width`` x ``height``
+    """The env's cylindrical panorama (``homing_gym.render.panorama``): ``width`` x ``height``
     pixels, vertical field of view ``vfov`` (radians). Pixel index ``j`` is the centre
     ``j + 0.5`` of the continuous coordinate, so bearing ``pi - 2 pi (x + 0.5) / W``."""
 
@@ -62,7 +62,7 @@ class PanoramaModel(CameraModel):
 
 @dataclass(frozen=True)
 class PerspectiveModel(CameraModel):
-    """A pinhole view (``homing_gym.perspective``): ``width`` x ``height`` pixels, focal
+    """A pinhole view (``homing_gym.render.perspective``): ``width`` x ``height`` pixels, focal
     length ``focal`` pixels, zero pitch and roll; pixel index ``i`` is the ray through
     image coordinate ``i + pixel_centre`` (0 for TinyRenderer, 0.5 for OpenGL)."""
 

@@ -17,7 +17,7 @@ correspondences between frames are the ids. Each :meth:`CornerTracker.update`
 **The seam.** Both steps run on the panorama padded with ``margin`` columns copied from
 the opposite edge, so a corner straddling the seam is detected once and a track crossing
 it continues; columns are mapped back modulo ``W``. Bearings follow the panorama
-convention of :mod:`homing_gym.panorama`, ``beta = pi - 2*pi*x/W`` (radians, CCW).
+convention of :mod:`homing_gym.render.panorama`, ``beta = pi - 2*pi*x/W`` (radians, CCW).
 
 Paper values (§5, long-range experiment): 100 strongest features, 7 x 7 windows,
 Gaussian smoothing with sigma 1.4 on 1394-pixel-wide panoramas. Our panoramas are 5 times
@@ -34,7 +34,7 @@ import cv2
 import numpy as np
 
 from homing_gym.geometry import wrap_angle
-from homing_gym.panorama import column_bearing
+from homing_gym.render.panorama import column_bearing
 
 
 @dataclass(frozen=True)

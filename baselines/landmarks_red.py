@@ -5,7 +5,7 @@ omnidirectional image into a panorama, average a 10-pixel-high horizontal slice 
 one-dimensional ring, and describe each landmark as an arc of that ring by its angular
 position θ (the arc midpoint, counter-clockwise from the heading, -180° < θ <= 180°) and
 its angular width. The env already gives the unwrapped panorama (``panorama``
-observation, :mod:`homing_gym.panorama` conventions), so we start from it.
+observation, :mod:`homing_gym.render.panorama` conventions), so we start from it.
 
 Choices (the paper leaves them open):
 
@@ -37,7 +37,7 @@ import cv2
 import numpy as np
 
 from homing_gym.geometry import wrap_angle
-from homing_gym.panorama import column_bearing
+from homing_gym.render.panorama import column_bearing
 
 #: The paper's slice: 10 px of an unwrapped image 160 px high (mirror radius, §III).
 PAPER_SLICE_FRACTION = 10 / 160

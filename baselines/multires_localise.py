@@ -56,7 +56,7 @@ import numpy as np
 from homing_baselines.multires_matching import (find_template, front_view, match_heading,
                                          predicted_directions, triangulate)
 from homing_gym.geometry import wrap_angle
-from homing_gym.panorama import bearing_column, column_bearing, row_elevation
+from homing_gym.render.panorama import bearing_column, column_bearing, row_elevation
 from homing_gym.teaching import FeatureMap
 from homing_gym.vision import grey, low_resolution
 

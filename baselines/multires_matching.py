@@ -34,7 +34,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from homing_gym.geometry import wrap_angle
-from homing_gym.panorama import column_bearing
+from homing_gym.render.panorama import column_bearing
 
 
 def _wrap_pad(image: np.ndarray, pad: int) -> np.ndarray:

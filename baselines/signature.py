@@ -3,14 +3,14 @@
 The signature is sampled on a bearing grid ``theta_k = (k + 1/2) * 360/n`` degrees
 (counter-clockwise from the robot heading, ``k = 0 .. n-1``; ``n = 360``: Hong's 1 degree
 interval). On the default panorama width 360 the grid coincides with the column centres
-(column ``x`` has bearing ``pi - 2*pi*x/W``, see :mod:`homing_gym.panorama`), so the
+(column ``x`` has bearing ``pi - 2*pi*x/W``, see :mod:`homing_gym.render.panorama`), so the
 panorama signature is a reordering of columns without interpolation.
 
 Two sources give the same signature (``tests/homing_baselines/test_snapshot.py`` checks it):
 
 * :func:`signature_from_omni`: §2 equation ``V_i = sum_{j=-2..2} I(i*dtheta, r_h + j*dr)``
   on the env's ``omni`` ring image (the paper's spherical-mirror view), ``r_h`` the
-  horizon circle (:func:`homing_gym.panorama.omni_horizon_radius`), ``dr`` one pixel;
+  horizon circle (:func:`homing_gym.render.panorama.omni_horizon_radius`), ``dr`` one pixel;
 * :func:`signature_from_panorama`: the same radial average over the panorama rows
   centred on the horizon (the env's ``signature`` observation, reordered by bearing).
 
@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from homing_gym.panorama import bearing_column, omni_horizon_radius, signature_weights
+from homing_gym.render.panorama import bearing_column, omni_horizon_radius, signature_weights
 from homing_gym.vision import luminance
 
 

@@ -20,7 +20,8 @@ view give the home direction ``α + π`` in the home frame, ``α + π - ψ`` in 
 Our choices (documented, not all fixed by the paper):
 
 * 1-D image: the panorama's luminance averaged over ``rows`` rows centred on the
-  horizon (the env's ``signature`` construction, :func:`homing_gym.panorama.signature_weights`),
+  horizon (the env's ``signature`` construction,
+  :func:`homing_gym.render.panorama.signature_weights`),
   then circularly smoothed with a Gaussian of ``smooth_deg``; one sample per column
   (256 = 1.41° for the default panorama).
 * Exhaustive search: α in ``n_alpha`` = 72 steps (5°), ρ in ``rho_values`` (0 to 0.95 in
@@ -42,7 +43,7 @@ import numpy as np
 from homing_baselines.base import Controller
 from homing_baselines.motion import Move
 from homing_gym.geometry import wrap_angle
-from homing_gym.panorama import bearing_column, column_bearing, signature_weights
+from homing_gym.render.panorama import bearing_column, column_bearing, signature_weights
 from homing_gym.vision import horizon_line
 from homing_gym.validation import is_real
 

@@ -20,17 +20,17 @@ from gymnasium import spaces
 from homing_gym.actions import DiscreteAction
 from homing_gym.geometry import finite_pose, to_frame
 from homing_gym.observations import CORE_KEYS, ObservationKey, Sight, goal_step_key
-from homing_gym.panorama import CameraConfig, Lighting, PanoramaCamera, random_lighting
+from homing_gym.render.panorama import CameraConfig, Lighting, PanoramaCamera, random_lighting
 from homing_gym.paths import occupancy
-from homing_gym.perspective import PerspectiveConfig, render_perspective
-from homing_gym.robot import RobotConfig, odometry_for
+from homing_gym.render.perspective import PerspectiveConfig, render_perspective
+from homing_gym.sim.robot import RobotConfig, odometry_for
 from homing_gym.scenes import scene_factory
 from homing_gym.scenes.base import Scene, clearance
-from homing_gym.simulator import Simulator, gui_unavailable
+from homing_gym.sim.simulator import Simulator, gui_unavailable
 from homing_gym.tasks.base import Task
 from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.episode import Episode
-from homing_gym.topdown import compose_frame, draw_topdown
+from homing_gym.render.topdown import compose_frame, draw_topdown
 from homing_gym.validation import (is_real, require_number, require_positive,
                                    require_sequence)
 
@@ -272,7 +272,7 @@ class HomingEnv(gym.Env):
         camera at ``pose`` (default: the robot's current pose; ``(x, y, yaw)`` in metres
         and radians), ``size = (width, height)`` pixels and ``hfov_deg`` degrees of
         horizontal field of view, under the episode's lighting. The world and the
-        episode are left untouched (see :mod:`homing_gym.perspective`)."""
+        episode are left untouched (see :mod:`homing_gym.render.perspective`)."""
         config = PerspectiveConfig(width=size[0], height=size[1], hfov=math.radians(hfov_deg))
         pose = self.pose if pose is None else finite_pose(pose)
         return render_perspective(self.sim.client, pose, self.robot_config.camera_height, config,

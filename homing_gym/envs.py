@@ -9,7 +9,7 @@ import numpy as np
 
 from homing_gym.env import HomingEnv, check_env_kwargs
 from homing_gym.geometry import FOOT
-from homing_gym.panorama import CameraConfig
+from homing_gym.render.panorama import CameraConfig
 from homing_gym.scenes import SceneFactory, scene_factory
 from homing_gym.scenes.base import Scene
 from homing_gym.scenes.daily_changes import daily_changes as daily_changes_of
@@ -60,7 +60,7 @@ class LocalHomingEnv(HomingEnv):
 
     Panorama convention: column ``x`` in ``[0, W)`` has bearing ``pi - 2*pi*x/W`` (radians,
     counter-clockwise from the heading): straight ahead at the centre column, directly
-    behind at the edges, the horizon at row ``H/2``. See :mod:`homing_gym.panorama`.
+    behind at the edges, the horizon at row ``H/2``. See :mod:`homing_gym.render.panorama`.
     ``odometry`` starts at zero in the start pose's frame (``odometry_origin="start"``,
     the default: path integration from where the robot was put, which says nothing about
     home) and then integrates the wheel encoders, each increment scaled by
@@ -119,7 +119,7 @@ class LocalHomingEnv(HomingEnv):
     ``"human"``: PyBullet GUI), ``obs_keys``, ``panorama_shape`` = (48, 256),
     ``vfov_deg`` = 60, ``n_views`` = 6, ``renderer`` = ``"raycast"`` (exact ray
     casting through the pixels, textures filtered like a camera's pixels, see
-    :mod:`homing_gym.raycast`; ``"tiny"``: PyBullet's TinyRenderer, six perspective views
+    :mod:`homing_gym.render.raycast`; ``"tiny"``: PyBullet's TinyRenderer, six perspective views
     remapped, homing-gym 0.1's default, 2-6x slower; ``"egl"``: PyBullet's OpenGL plugin),
     ``supersampling`` = 2 (raycast: ``k x k`` rays averaged per panorama pixel, 1-4), ``omni_size`` = 128,
     ``action_type``, ``control_period`` (at most 2 s), ``physics_substeps`` (1-1000; each
@@ -128,7 +128,7 @@ class LocalHomingEnv(HomingEnv):
     ``odometry_origin`` = ``"start"`` (or ``"home"``), ``drive`` = ``"differential"``
     (or ``"synchro"``: the body translates without turning, as Hong et al.'s robot; the
     continuous action is then the body-frame velocity ``(vx, vy)``, speed at most
-    ``max_speed``; see :mod:`homing_gym.robot`), ``goal_step_length`` = 0.15,
+    ``max_speed``; see :mod:`homing_gym.sim.robot`), ``goal_step_length`` = 0.15,
     ``lighting_change`` = 0
     (0-1: strength of an illumination change between the home snapshot and the run, drawn
     from the seed: light direction, brightness, contrast),
@@ -136,7 +136,7 @@ class LocalHomingEnv(HomingEnv):
     about 0.1 m, use ``renderer="raycast"``, which never sees the robot's own body),
     ``sky_color`` (RGB in [0, 1] of rays that hit nothing; ``renderer="raycast"`` only),
     ``shadows`` = False (``renderer="raycast"`` only: objects cast shadows from the scene
-    light, which moves with ``lighting_change``; see :mod:`homing_gym.shadows`),
+    light, which moves with ``lighting_change``; see :mod:`homing_gym.render.shadows`),
     ``episodes_per_world`` = 1 (a randomised scene draws a new world on every seeded reset
     and on every ``episodes_per_world``-th unseeded one: for training, where building a
     procedural world, 30-70 ms, would dominate short episodes),

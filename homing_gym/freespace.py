@@ -26,7 +26,7 @@ import numpy as np
 from homing_gym.cli import add_env_arguments, command_parser, env_kwargs_from_args
 from homing_gym.paths import RESOLUTION, occupancy, regions
 from homing_gym.scenes.base import Scene
-from homing_gym.topdown import (HOME, ROBOT, MapCanvas, compose_frame, draw_pose,
+from homing_gym.render.topdown import (HOME, ROBOT, MapCanvas, compose_frame, draw_pose,
                                 draw_scale_bar, draw_scene)
 
 #: RGB of the largest free region, of the other regions (in turn) and of blocked floor.
@@ -77,7 +77,7 @@ def free_space(scene: Scene, radius: float) -> FreeSpace:
 
 
 def free_space_image(scene: Scene, radius: float, size: int = 520) -> np.ndarray:
-    """The scene from above (:func:`~homing_gym.topdown.draw_scene`) under the free
+    """The scene from above (:func:`~homing_gym.render.topdown.draw_scene`) under the free
     regions for a disc of ``radius`` metres (largest :data:`LARGEST`, the others
     :data:`OTHERS` by size, blocked :data:`BLOCKED`) and a scale bar; RGB uint8."""
     canvas = MapCanvas(scene, size)

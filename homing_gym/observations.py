@@ -17,14 +17,14 @@ from dataclasses import dataclass
 import numpy as np
 from gymnasium import spaces
 
-from homing_gym.panorama import CameraConfig, PanoramaCamera
+from homing_gym.render.panorama import CameraConfig, PanoramaCamera
 
 
 class Sight:
     """What the robot's camera and encoders give at one pose.
 
     ``panorama``: the panorama there (uint8 HWC), rendered when first read;
-    ``camera``: the :class:`~homing_gym.panorama.PanoramaCamera` (for the ring image and
+    ``camera``: the :class:`~homing_gym.render.panorama.PanoramaCamera` (for the ring image and
     the signature derived from a panorama); ``odometry``: the wheel-odometry estimate
     ``(x, y, yaw)`` (metres, radians), or ``None`` for a goal snapshot;
     ``panorama_ahead(d)``: the panorama ``d`` metres straight ahead (goal snapshots only);

@@ -25,7 +25,7 @@ from scipy import ndimage
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from homing_gym.robot import RobotConfig
+from homing_gym.sim.robot import RobotConfig
 from homing_gym.scenes.base import Scene, clearances, per_scene
 
 #: Floor points whose clearances are computed at once (bounds the memory of big worlds).

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from homing_gym.panorama import bearing_column
+from homing_gym.render.panorama import bearing_column
 from homing_gym.validation import require_positive
 from homing_gym.vision import grey, low_resolution
 

@@ -43,7 +43,7 @@ def grey(image: np.ndarray) -> np.ndarray:
 
 def horizon_line(panorama: np.ndarray, weights: np.ndarray) -> np.ndarray:
     """Luminance in ``[0, 1]`` of each column, ``weights @ rows``: float32 ``(W,)``.
-    ``weights`` ``(H,)`` mixes the rows (see ``homing_gym.panorama.signature_weights``)."""
+    ``weights`` ``(H,)`` mixes the rows (see ``homing_gym.render.panorama.signature_weights``)."""
     return (weights @ luminance(panorama, 255.0)) / np.float32(255.0)
 
 

@@ -26,7 +26,7 @@ COMMANDS = {
     "python -m homing_train.learning.rllib_ppo": "homing_train.learning.rllib_ppo",
     "python -m homing_train.learning.saturation": "homing_train.learning.saturation",
     "python -m homing_gym.envcard": "homing_gym.envcard",
-    "python -m homing_gym.textures": "homing_gym.textures",
+    "python -m homing_gym.scenes.textures": "homing_gym.scenes.textures",
     "python -m homing_gym.scenes.mesh_example": "homing_gym.scenes.mesh_example",
     "python -m homing_gym.scenes.tussocks": "homing_gym.scenes.tussocks",
     "python -m homing_gym.freespace": "homing_gym.freespace",
@@ -81,7 +81,7 @@ def test_textures_are_written_where_asked_and_match_the_shipped_ones(tmp_path):
     import cv2
     import numpy as np
 
-    from homing_gym.textures import TEXTURE_DIR, main
+    from homing_gym.scenes.textures import TEXTURE_DIR, main
     assert main(["--out", str(tmp_path)]) == 0
     written = sorted(path.name for path in tmp_path.iterdir())
     assert written == sorted(path.name for path in TEXTURE_DIR.glob("*.png"))

@@ -1,9 +1,9 @@
 """Declarative scene description: floor, walls and landmarks as frozen dataclasses.
 
-A scene is plain data; :class:`~homing_gym.simulator.Simulator` turns it into PyBullet
+A scene is plain data; :class:`~homing_gym.sim.simulator.Simulator` turns it into PyBullet
 bodies. Units: metres and radians (yaw counter-clockwise from world +x). Colours are
 RGBA in ``[0, 1]``. A texture is the name of a PNG shipped in ``homing_gym/assets/textures``
-(see :func:`homing_gym.textures.available_textures`) or a path to a PNG file.
+(see :func:`homing_gym.scenes.textures.available_textures`) or a path to a PNG file.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import numpy as np
 
 from homing_gym.scenes.footprint import ClearanceField, clearance_field
 from homing_gym.scenes.mesh_part import MeshPart, check_face_count
-from homing_gym.textures import check_texture
+from homing_gym.scenes.textures import check_texture
 from homing_gym.validation import require_positive
 
 SHAPES = ("cylinder", "box", "panel")

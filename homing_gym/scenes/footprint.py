@@ -21,7 +21,7 @@ ceiling, a table top or a roof seen from inside faces down and leaves the floor 
 nearly vertical triangles (``|normal z| <`` :data:`STEEP`) hide what lies above them but
 face neither way. A z-buffer over the grid points (numba) finds that surface. Only
 colliding parts count, for this as for the rest. The same triangles (those reaching into
-the band) become the PyBullet collision body (:mod:`homing_gym.simulator`), so what the
+the band) become the PyBullet collision body (:mod:`homing_gym.sim.simulator`), so what the
 planner avoids is what the robot bumps into.
 """
 

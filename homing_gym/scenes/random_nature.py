@@ -26,7 +26,7 @@ from homing_gym.scenes.mesh_part import MeshPart
 
 SKY = (0.62, 0.76, 0.92)
 #: The ground's and the hills' reach (metres): within TinyRenderer's 30 m far plane
-#: (:class:`~homing_gym.panorama.CameraConfig`), so both renderers show them.
+#: (:class:`~homing_gym.render.panorama.CameraConfig`), so both renderers show them.
 GROUND_RADIUS = 28.0
 HILL_DISTANCE = (18.0, 26.0)
 #: Least gap (metres) between the footprints of two obstacles: the robot (0.32 m) fits.

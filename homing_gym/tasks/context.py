@@ -13,8 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from homing_gym.panorama import CameraConfig
-from homing_gym.robot import RobotConfig
+from homing_gym.render.panorama import CameraConfig
+from homing_gym.sim.robot import RobotConfig
 from homing_gym.scenes.base import Scene
 from homing_gym.tasks.episode import Episode
 

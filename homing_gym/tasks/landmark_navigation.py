@@ -28,7 +28,7 @@ from gymnasium import spaces
 from homing_gym.geometry import bearing_to, wrap_angle
 from homing_gym.observations import ObservationKey, constant_key
 from homing_gym.paths import connected
-from homing_gym.perspective import PerspectiveConfig
+from homing_gym.render.perspective import PerspectiveConfig
 from homing_gym.scenes.base import Scene, clearance
 from homing_gym.selfsimilar import MAX_ID
 from homing_gym.tasks.context import TaskContext

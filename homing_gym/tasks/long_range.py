@@ -20,7 +20,7 @@ from gymnasium import spaces
 from homing_gym.geometry import bearing_to
 from homing_gym.observations import ObservationKey, constant_key
 from homing_gym.paths import segment_free
-from homing_gym.robot import RobotConfig
+from homing_gym.sim.robot import RobotConfig
 from homing_gym.scenes.base import Scene
 from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.base import Episode, sample_free_pose

@@ -13,7 +13,7 @@ from homing_baselines.motion import Move
 from homing_gym.envs import LocalHomingEnv
 from homing_gym.scenes import available_scenes, scene_factory
 from homing_gym.scenes.base import clearance
-from homing_gym.simulator import Simulator
+from homing_gym.sim.simulator import Simulator
 from homing_train.harness.evaluate import evaluate, run_episode
 from homing_train.harness.rollout import prepare_policy
 

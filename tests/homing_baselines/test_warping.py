@@ -10,7 +10,7 @@ import pytest
 from homing_baselines.warping import (WarpingConfig, WarpingController, warp_bearings, warp_search,
                                warping_homing)
 from homing_gym.geometry import wrap_angle
-from homing_gym.panorama import column_bearing
+from homing_gym.render.panorama import column_bearing
 
 
 def test_warp_bearings_match_exact_geometry_on_the_landmark_circle():

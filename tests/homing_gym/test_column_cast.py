@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 
 from homing_gym.benchmark import grass_world, mesh_world
-from homing_gym.column_cast import CELL, _ATAN_SLACK, _approx_atan2, cast_columns, triangle_grid
-from homing_gym.raycast import camera_rays, panorama_rays, perspective_rays
-from homing_gym.worldmesh import world_mesh
+from homing_gym.render.column_cast import (CELL, _ATAN_SLACK, _approx_atan2, cast_columns,
+                                           triangle_grid)
+from homing_gym.render.raycast import camera_rays, panorama_rays, perspective_rays
+from homing_gym.render.worldmesh import world_mesh
 
 
 @pytest.fixture(scope="module")
@@ -181,10 +182,10 @@ _ODD_CAMERAS = """
 import sys
 import numpy as np
 from homing_gym.benchmark import grass_world, mesh_world
-from homing_gym.panorama import CameraConfig, Lighting
-from homing_gym.raycast import RayCaster
+from homing_gym.render.panorama import CameraConfig, Lighting
+from homing_gym.render.raycast import RayCaster
 from homing_gym.scenes import scene_factory
-from homing_gym.worldmesh import world_mesh
+from homing_gym.render.worldmesh import world_mesh
 rng = np.random.default_rng(0)
 for scene in (mesh_world(), grass_world(30000), scene_factory("hallway").build(rng),
               scene_factory("random_rooms").build(rng)):

@@ -5,7 +5,7 @@ import pytest
 
 from homing_gym import freespace
 from homing_gym.scenes.base import Scene, Wall
-from homing_gym.topdown import MapCanvas
+from homing_gym.render.topdown import MapCanvas
 
 
 def unequal_rooms() -> Scene:

@@ -40,7 +40,7 @@ def test_200_make_close_cycles_leak_nothing():
 
 def test_a_mesh_shape_gets_only_the_corners_its_faces_use():
     # PyBullet never releases the vertex lists it is given: pass no unused corner
-    from homing_gym.simulator import _used_vertices
+    from homing_gym.sim.simulator import _used_vertices
     vertices = np.arange(30, dtype=np.float64).reshape(10, 3)
     faces = np.array([[7, 2, 9], [9, 2, 4]])
     corners, indices = _used_vertices(vertices, faces)

@@ -12,7 +12,7 @@ from homing_gym.scenes.base import clearance, clearances
 from homing_gym.scenes.mesh_part import MeshPart
 from homing_gym.scenes.mesh_example import (LEG_HALF, PILLAR, example_room_parts,
                                             write_example_room)
-from homing_gym.topdown import BG, MapCanvas, draw_scene
+from homing_gym.render.topdown import BG, MapCanvas, draw_scene
 from homing_train.harness.rollout import rollout
 
 
@@ -214,7 +214,7 @@ def test_textured_mesh_shows_its_texture_in_the_ray_caster(tmp_path, make_env):
 
 def test_benchmark_mesh_world_has_ten_thousand_triangles(make_env):
     from homing_gym.benchmark import mesh_world
-    from homing_gym.worldmesh import world_mesh
+    from homing_gym.render.worldmesh import world_mesh
 
     scene = mesh_world()
     assert len(world_mesh(scene).triangles) > 9_500

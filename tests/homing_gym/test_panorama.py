@@ -8,7 +8,7 @@ import pybullet as p
 import pytest
 
 from homing_gym.geometry import bearing_to
-from homing_gym.panorama import (bearing_column, column_bearing, omni_horizon_radius,
+from homing_gym.render.panorama import (bearing_column, column_bearing, omni_horizon_radius,
                                  signature_weights)
 from homing_gym.scenes import Landmark, Scene
 
@@ -138,7 +138,7 @@ def test_signature_matches_horizon_rows(make_env):
 
 
 def test_safe_eye_moves_only_an_eye_whose_view_plane_holds_a_corner():
-    from homing_gym.panorama import EYE_SHIFT, safe_eye
+    from homing_gym.render.panorama import EYE_SHIFT, safe_eye
 
     corners = np.array([[4.45, 1.1, 0.0], [4.45, 0.0, 2.4]])       # a wall's end, y = 1.1
     assert safe_eye((6.2, 1.1, 0.3), (0.0, -1.0), corners) == (6.2, 1.1 + EYE_SHIFT)

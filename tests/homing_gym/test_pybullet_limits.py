@@ -10,7 +10,7 @@ import pytest
 
 from homing_gym.scenes import scene_factory
 from homing_gym.scenes.mesh_scene import MeshScene
-from homing_gym.simulator import Simulator
+from homing_gym.sim.simulator import Simulator
 
 WALL_X = 1.0
 

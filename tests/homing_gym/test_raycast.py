@@ -6,10 +6,10 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-from homing_gym.panorama import Lighting, bearing_column
-from homing_gym.perspective import PerspectiveConfig
-from homing_gym.column_cast import _first_past
-from homing_gym.raycast import RayCaster
+from homing_gym.render.panorama import Lighting, bearing_column
+from homing_gym.render.perspective import PerspectiveConfig
+from homing_gym.render.column_cast import _first_past
+from homing_gym.render.raycast import RayCaster
 from homing_gym.scenes import Landmark, Scene, available_scenes
 from homing_gym.vision import luminance
 
@@ -154,11 +154,11 @@ def test_every_pixel_hits_what_embree_hits(scene):
     embree = pytest.importorskip("embreex.rtcore_scene")
     from embreex.mesh_construction import TriangleMesh
 
-    from homing_gym.column_cast import cast_columns, triangle_grid
-    from homing_gym.raycast import panorama_rays, perspective_rays
+    from homing_gym.render.column_cast import cast_columns, triangle_grid
+    from homing_gym.render.raycast import panorama_rays, perspective_rays
     from homing_gym.scenes import scene_factory
     from homing_gym.scenes.base import clearance
-    from homing_gym.worldmesh import world_mesh
+    from homing_gym.render.worldmesh import world_mesh
 
     world = scene_factory(scene).build(np.random.default_rng(0))
     mesh = world_mesh(world)
@@ -216,8 +216,8 @@ def test_camera_height_and_sky_color():
 def test_cast_shadows_darken_the_floor_behind_an_object_and_nothing_else(make_env):
     """A 1 m box at the origin, the light from +x at 45 degrees: the floor from x = -0.2
     to about -1.2 m (|y| < 0.5) lies in its shadow and gets the ambient light alone."""
-    from homing_gym.panorama import CameraConfig
-    from homing_gym.worldmesh import world_mesh
+    from homing_gym.render.panorama import CameraConfig
+    from homing_gym.render.worldmesh import world_mesh
 
     scene = Scene("block", ((-3, -3), (3, 3)),
                   landmarks=(Landmark((0.0, 0.0), shape="box", extent=(0.4, 1.0),
@@ -249,7 +249,7 @@ def test_texture_samples_wrap_round_the_edges(monkeypatch, float64_bytes):
     """Bilinear samples on the edge of a texture blend in the texels of the opposite edge
     (the atlas stores each level with a wrapped border), in float32 and float64 atlases."""
     from homing_gym import raycast
-    from homing_gym.column_cast import _texel
+    from homing_gym.render.column_cast import _texel
 
     monkeypatch.setattr(raycast, "ATLAS_FLOAT64_BYTES", float64_bytes)
     texture = np.arange(24, dtype=np.float32).reshape(2, 4, 3) / 24    # row 0 at the top

@@ -9,9 +9,9 @@ import trimesh
 
 from homing_gym.scenes import available_scenes, scene_factory
 from homing_gym.scenes.base import Landmark, Wall, clearances
-from homing_gym.simulator import Simulator
-from homing_gym.solids import Solid, landmark_solid, wall_solid
-from homing_gym.worldmesh import world_mesh
+from homing_gym.sim.simulator import Simulator
+from homing_gym.scenes.solids import Solid, landmark_solid, wall_solid
+from homing_gym.render.worldmesh import world_mesh
 
 #: Horizontal rays per origin, and their heights (metres): the robot's body height band.
 RAYS, HEIGHTS = 48, (0.05, 0.15, 0.25)

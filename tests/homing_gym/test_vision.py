@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from homing_gym import DiscreteAction
-from homing_gym.panorama import signature_weights
+from homing_gym.render.panorama import signature_weights
 from homing_gym.vision import grey, horizon_line, low_resolution, low_resolution_shape, luminance
 
 PURE = {"red": ((255, 0, 0), 0.299), "green": ((0, 255, 0), 0.587),

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from homing_gym.panorama import column_bearing
+from homing_gym.render.panorama import column_bearing
 from homing_gym.scenes.base import clearance
 from homing_gym.scenes.daily_changes import daily_changes
 from homing_gym.scenes.house import house_scene

@@ -26,7 +26,7 @@ import numpy as np
 
 import homing_gym  # noqa: F401  (registers the env ids)
 from homing_gym.cli import command_parser
-from homing_gym.topdown import BG, MapCanvas, draw_scale_bar, draw_topdown, labelled
+from homing_gym.render.topdown import BG, MapCanvas, draw_scale_bar, draw_topdown, labelled
 from homing_train.harness.evaluate import EpisodeRecord, EvalResult
 from homing_train.harness.matrix import setting_stem
 from homing_train.harness.metrics import wilson_interval

@@ -20,7 +20,8 @@ import numpy as np
 import homing_gym  # noqa: F401  (registers the env ids)
 from homing_gym.cli import command_parser
 from homing_gym.scenes.mesh_example import write_example_room
-from homing_gym.topdown import BG, ROBOT, MapCanvas, labelled, draw_pose, draw_scale_bar, draw_scene
+from homing_gym.render.topdown import (BG, ROBOT, MapCanvas, labelled, draw_pose, draw_scale_bar,
+                                       draw_scene)
 from homing_train.outputs import output_dir_argument
 
 PANORAMA = (60, 360)

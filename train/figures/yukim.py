@@ -54,7 +54,7 @@ from homing_baselines.warping import WarpingController, warping_homing  # noqa: 
 from homing_gym.cli import command_parser, seed_value, worker_count  # noqa: E402
 from homing_gym.geometry import wrap_angle  # noqa: E402
 from homing_gym.scenes.base import clearance  # noqa: E402
-from homing_gym.topdown import HOME, MapCanvas, draw_pose, draw_scene  # noqa: E402
+from homing_gym.render.topdown import HOME, MapCanvas, draw_pose, draw_scene  # noqa: E402
 from homing_train.harness.metrics import wilson_interval  # noqa: E402
 from homing_train.figures import MEASURED_WITH  # noqa: E402
 from homing_train.harness.protocols import ring_starts  # noqa: E402

@@ -30,7 +30,7 @@ from tqdm import tqdm  # noqa: E402
 import homing_gym  # noqa: E402,F401
 from homing_gym.cli import (add_env_arguments, command_parser,  # noqa: E402
                             env_kwargs_from_args, seed_value)
-from homing_gym.panorama import bearing_column  # noqa: E402
+from homing_gym.render.panorama import bearing_column  # noqa: E402
 from homing_train import DEFAULT_ENV  # noqa: E402
 from homing_train.harness.evaluate import check_env_id  # noqa: E402
 from homing_train.harness.rollout import prepare_policy, rollout  # noqa: E402

@@ -39,7 +39,7 @@ from homing_gym.cli import command_parser, env_kwargs_from_args  # noqa: E402
 from homing_gym.geometry import wrap_angle  # noqa: E402
 from homing_gym.paths import connected  # noqa: E402
 from homing_gym.scenes.base import clearances  # noqa: E402
-from homing_gym.topdown import MapCanvas, draw_pose, draw_scale_bar, draw_scene  # noqa: E402
+from homing_gym.render.topdown import MapCanvas, draw_pose, draw_scale_bar, draw_scene  # noqa: E402
 from homing_train.harness.evaluate import (DEFAULT_ENV, add_policy_arguments,  # noqa: E402
                                            check_env_id, policy_from_args, run_episodes)
 from homing_train.harness.palette import HOME_MARK  # noqa: E402

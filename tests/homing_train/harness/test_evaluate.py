@@ -66,7 +66,7 @@ def test_non_oracle_controllers_get_only_the_observation():
         assert state is None and isinstance(episode_start, bool)
     # nothing the controller holds or was handed leads to the env, its simulator or info
     forbidden = (gym.Env,)
-    from homing_gym.simulator import Simulator
+    from homing_gym.sim.simulator import Simulator
     for obj in list(_walk(SpyController.calls)) + list(_walk(spy)):
         assert not isinstance(obj, forbidden + (Simulator,))
         assert not (isinstance(obj, dict) and {"pose", "goal_pose"} & set(obj))

@@ -1,26 +1,26 @@
 """The ray-cast renderer (``renderer="raycast"``): one ray per pixel through the pixel
-centre, intersected exactly with the scene's triangles (:mod:`homing_gym.worldmesh`) by
-:func:`homing_gym.column_cast.cast_columns`.
+centre, intersected exactly with the scene's triangles (:mod:`homing_gym.render.worldmesh`) by
+:func:`homing_gym.render.column_cast.cast_columns`.
 
-Panorama rays follow the camera conventions of :mod:`homing_gym.panorama` exactly:
+Panorama rays follow the camera conventions of :mod:`homing_gym.render.panorama` exactly:
 column ``j`` (centre ``j + 0.5``) has bearing ``pi - 2*pi*(j + 0.5)/W``
 counter-clockwise from the heading, row ``i`` the elevation
 ``vfov/2 - vfov*(i + 0.5)/H``; no resampling. Perspective rays are those of an upright
-pinhole with square pixels (:class:`~homing_gym.perspective.PerspectiveConfig`), through
+pinhole with square pixels (:class:`~homing_gym.render.perspective.PerspectiveConfig`), through
 pixel centres. Shading: the triangle's colour, times its texture if it has one (filtered
 over a pixel's footprint by trilinear mip-mapping, as a camera pixel integrates light:
-:func:`homing_gym.column_cast.shade`; each of a pixel's ``k x k`` rays filters over the
+:func:`homing_gym.render.column_cast.shade`; each of a pixel's ``k x k`` rays filters over the
 whole pixel, so their mean covers about a pixel and a half, like a pixel seen through
 its lens' blur; with nearest texels distant textures aliased, and with each ray filtering
 only its ``1/k`` share Hong's route following still lost targets on some seeds:
 ``docs/benchmark.md``), times ``ambient + diffuse * max(0, n . l)`` (Lambert with the
-:class:`~homing_gym.panorama.Lighting` direction ``l``, ``n`` the face's normal on the
+:class:`~homing_gym.render.panorama.Lighting` direction ``l``, ``n`` the face's normal on the
 side the camera sees: a face turned away from the light gets the ambient term alone, as
 in TinyRenderer, so walls of different orientation differ in brightness), clipped, then
 the lighting's brightness/contrast change; rays that hit nothing see ``sky_color``. With
 ``supersampling = k`` each pixel averages ``k x k`` rays spread evenly over its area
 (panoramas: ``CameraConfig.supersampling``, perspective views:
-:data:`~homing_gym.perspective.VIEW_SUPERSAMPLING`). The
+:data:`~homing_gym.render.perspective.VIEW_SUPERSAMPLING`). The
 robot's own body is not part of the world mesh, so it never occludes the camera. The
 same pose gives the same pixels.
 
@@ -39,11 +39,11 @@ from typing import NamedTuple
 import cv2
 import numpy as np
 
-from homing_gym.column_cast import cast_columns, lit_colors, shade, triangle_grid
-from homing_gym.panorama import (DEFAULT_LIGHTING, CameraConfig, Lighting, column_bearing,
+from homing_gym.render.column_cast import cast_columns, lit_colors, shade, triangle_grid
+from homing_gym.render.panorama import (DEFAULT_LIGHTING, CameraConfig, Lighting, column_bearing,
                                  photometric, row_elevation)
-from homing_gym.shadows import ShadowMap, shadow_map
-from homing_gym.worldmesh import WorldMesh
+from homing_gym.render.shadows import ShadowMap, shadow_map
+from homing_gym.render.worldmesh import WorldMesh
 
 #: The shadow map of a caster without shadows (empty: ``shade`` skips the lookups).
 _NO_SHADOWS = ShadowMap(np.zeros((0, 0)), np.eye(3), np.zeros(2), 1.0)
@@ -126,7 +126,7 @@ class TextureAtlas(NamedTuple):
     """Every mip level of every texture in one flat array, as :func:`shade` reads them:
     ``atlas`` the levels' RGB values (in [0, 1]) one after another, each with a border
     of one texel wrapped round from the opposite side
-    (:func:`~homing_gym.column_cast.texel_offset`); ``levels[m] = (offset, height,
+    (:func:`~homing_gym.render.column_cast.texel_offset`); ``levels[m] = (offset, height,
     width)`` of level ``m`` (its size without the border); texture ``k``'s levels from
     ``first_level[k]`` to ``first_level[k + 1]``."""
 
@@ -192,7 +192,7 @@ class RayCaster:
         self._everywhere = np.ones(len(self._texture), np.bool_)
         self._atlas, self._levels, self._first_level = texture_atlas(mesh.textures)
         self._texel_density = texel_density(mesh)
-        #: Cast shadows (:mod:`homing_gym.shadows`); maps cached per light direction.
+        #: Cast shadows (:mod:`homing_gym.render.shadows`); maps cached per light direction.
         self.shadows = shadows
         self._shadow_maps: dict[tuple, ShadowMap] = {}
         self._scratch: dict[tuple[int, int], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}

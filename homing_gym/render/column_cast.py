@@ -37,7 +37,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from homing_gym.shadows import in_shadow
+from homing_gym.render.shadows import in_shadow
 
 #: Hits nearer than this (metres, horizontally) are ignored: the camera's own position.
 NEAR = 1e-6
@@ -485,7 +485,7 @@ def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
     (radians); ``beta (W,)`` column bearings relative to the heading, strictly
     descending within ``(-pi, pi]``; ``tan_elev (H, W)`` tangent of each pixel's ray
     elevation, descending down each column; ``circle``, ``even_rows``, ``top_angle``,
-    ``rows_per_radian``: their layout (:class:`homing_gym.raycast.Rays`; with columns
+    ``rows_per_radian``: their layout (:class:`homing_gym.render.raycast.Rays`; with columns
     once round the circle at even steps a span's columns are found by arithmetic, else
     by searching ``beta``; with rows even in elevation and the same in every column,
     segments that fall between two rows are dropped early). Writes ``hit (H, W)`` the
@@ -839,7 +839,7 @@ def shade(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.nd
     (full resolution first, each half the size of the one before). A face whose UVs cover
     no area (one texel for the whole face) takes that texel.
 
-    Cast shadows (:mod:`homing_gym.shadows`; off when ``shadow_depth`` is empty): a point
+    Cast shadows (:mod:`homing_gym.render.shadows`; off when ``shadow_depth`` is empty): a point
     in the shadow of the map takes ``shaded[t]`` (the ambient light alone) instead of
     ``base[t]``.
 

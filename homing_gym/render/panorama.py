@@ -22,7 +22,7 @@ Conventions (tested in ``tests/homing_gym/test_panorama.py``):
   and centred on the horizon (linear interpolation between rows).
 
 By default (``renderer="raycast"``) the panorama is ray cast directly
-(:mod:`homing_gym.raycast`). With ``"tiny"`` or ``"egl"`` it is rendered by PyBullet from
+(:mod:`homing_gym.render.raycast`). With ``"tiny"`` or ``"egl"`` it is rendered by PyBullet from
 ``n_views`` perspective cameras at the camera centre, facing evenly spaced yaws, and
 resampled into the cylinder with a single precomputed ``cv2.remap``. The renderers give
 the same geometry; their shading and background colour differ, so do not mix them
@@ -270,7 +270,7 @@ class PanoramaCamera:
                  renderer: int = p.ER_TINY_RENDERER, caster=None, vertices=None):
         """``renderer``: PyBullet's renderer for the perspective views; ``caster``: a
         callable returning the simulator's current
-        :class:`~homing_gym.raycast.RayCaster`, which then renders instead; ``vertices``:
+        :class:`~homing_gym.render.raycast.RayCaster`, which then renders instead; ``vertices``:
         a callable returning the world's triangle corners ``(V, 3)``, so that PyBullet's
         views avoid the poses at which TinyRenderer never returns (:func:`safe_eye`)."""
         self.config = config

@@ -1,6 +1,6 @@
 """Cast shadows for the ray caster (``shadows=True``): a shadow map along the light.
 
-The scene light is directional (:class:`~homing_gym.panorama.Lighting`: ``direction``
+The scene light is directional (:class:`~homing_gym.render.panorama.Lighting`: ``direction``
 towards the light). Every triangle is projected onto the plane perpendicular to it and
 rasterised into a grid (:data:`MAX_CELLS` cells a side at most, cells no finer than
 :data:`FINEST` metres) that keeps, per cell, the greatest height towards the light of

@@ -90,7 +90,7 @@ def wheel_speeds(v: float, w: float, config: RobotConfig) -> tuple[float, float]
 
 
 class Robot:
-    """The robot body inside one :class:`~homing_gym.simulator.Simulator` client."""
+    """The robot body inside one :class:`~homing_gym.sim.simulator.Simulator` client."""
 
     def __init__(self, client: BulletClient, config: RobotConfig = RobotConfig()):
         self.client = client

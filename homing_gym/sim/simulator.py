@@ -27,15 +27,15 @@ import pybullet as p
 from pybullet_utils.bullet_client import BulletClient
 
 from homing_gym.native_output import native_output_captured
-from homing_gym.raycast import SKY_COLOR, RayCaster
-from homing_gym.robot import Robot, RobotConfig
+from homing_gym.render.raycast import SKY_COLOR, RayCaster
+from homing_gym.sim.robot import Robot, RobotConfig
 from homing_gym.scenes.base import Scene
 from homing_gym.scenes.footprint import band_faces
 from homing_gym.scenes.mesh_part import MeshPart
-from homing_gym.solids import (Solid, fence_solids, floor_rectangle, floor_top, landmark_solid,
-                               wall_solid)
-from homing_gym.textures import texture_path
-from homing_gym.worldmesh import world_mesh
+from homing_gym.scenes.solids import (Solid, fence_solids, floor_rectangle, floor_top,
+                                      landmark_solid, wall_solid)
+from homing_gym.scenes.textures import texture_path
+from homing_gym.render.worldmesh import world_mesh
 
 #: ``createMultiBody`` options of every static body (floor, walls, landmarks, mesh
 #: parts): a PyBullet rigid body rather than a fixed-base multibody, which the solver
@@ -217,7 +217,7 @@ class Simulator:
 
     def world_vertices(self) -> np.ndarray:
         """The distinct corners ``(V, 3)`` (metres) of the current world's triangles
-        (:func:`~homing_gym.worldmesh.world_mesh`), computed once per world."""
+        (:func:`~homing_gym.render.worldmesh.world_mesh`), computed once per world."""
         if self._vertices_of is not self.scene:
             corners = world_mesh(self.scene).triangles.reshape(-1, 3).astype(np.float64)
             self._vertices, self._vertices_of = np.unique(corners, axis=0), self.scene

@@ -1,7 +1,7 @@
 """A scene as one set of textured triangles: what the ray-cast renderer sees.
 
 :func:`world_mesh` turns a :class:`~homing_gym.scenes.base.Scene` into triangles: the top
-face of its floor and the sides of its :mod:`~homing_gym.solids` (the description the
+face of its floor and the sides of its :mod:`~homing_gym.scenes.solids` (the description the
 PyBullet bodies are built from too: boxes as boxes, cylinders as 64-sided prisms), then its
 mesh parts as they are; a textured part's texture repeats outside ``[0, 1]`` uv. Each
 triangle has a colour (RGB in ``[0, 1]``), a texture index (``-1``: none) and texture
@@ -23,8 +23,8 @@ import numpy as np
 
 from homing_gym.scenes.base import Scene
 from homing_gym.scenes.mesh_part import MeshPart
-from homing_gym.solids import Solid, floor_rectangle, floor_top, landmark_solid, wall_solid
-from homing_gym.textures import load_texture
+from homing_gym.scenes.solids import Solid, floor_rectangle, floor_top, landmark_solid, wall_solid
+from homing_gym.scenes.textures import load_texture
 
 #: Sides of the prism that stands for a cylinder: the silhouette is within
 #: ``r (1 - cos(pi/64))`` = 0.1 % of the radius of the true circle.

@@ -1,7 +1,7 @@
 """Textures shipped as package data, and the procedural generator that made them.
 
 The PNGs in ``homing_gym/assets/textures`` are produced deterministically by
-``python -m homing_gym.textures`` (seeded), so they can be regenerated and reviewed.
+``python -m homing_gym.scenes.textures`` (seeded), so they can be regenerated and reviewed.
 """
 
 from __future__ import annotations
@@ -128,7 +128,7 @@ def generate_textures(size: int = 128, seed: int = 7) -> dict[str, np.ndarray]:
 def main(argv: list[str] | None = None) -> int:
     """Regenerate the shipped texture PNGs (``--out DIR`` writes them elsewhere)."""
     from homing_gym.cli import command_parser
-    parser = command_parser("python -m homing_gym.textures", __doc__)
+    parser = command_parser("python -m homing_gym.scenes.textures", __doc__)
     parser.add_argument("--out", type=Path, default=TEXTURE_DIR,
                         help="folder to write the PNGs to (default: the package's own)")
     out = parser.parse_args(argv).out

@@ -1,6 +1,6 @@
 """A scene's solids: the one description of its geometry that both the ray caster's
-triangles (:func:`homing_gym.worldmesh.world_mesh`) and PyBullet's bodies
-(:class:`homing_gym.simulator.Simulator`) are built from, so that what the robot sees is
+triangles (:func:`homing_gym.render.worldmesh.world_mesh`) and PyBullet's bodies
+(:class:`homing_gym.sim.simulator.Simulator`) are built from, so that what the robot sees is
 what it bumps into.
 
 A wall is a box whose length takes in the wall's thickness (so that walls meeting at a

@@ -1,6 +1,6 @@
 """Ordinary perspective camera views from the robot's camera (pinhole, no distortion).
 
-The panoramic camera (:mod:`homing_gym.panorama`) is what the robot observes; a
+The panoramic camera (:mod:`homing_gym.render.panorama`) is what the robot observes; a
 perspective view is rendered on request (:meth:`homing_gym.env.HomingEnv.render_view`),
 like the forward camera of Briggs et al. 2000 (Fig. 6: 640 x 480 and 320 x 240 images).
 It changes nothing in the world, so it can be called in the middle of an episode.
@@ -22,7 +22,7 @@ import numpy as np
 import pybullet as p
 from pybullet_utils.bullet_client import BulletClient
 
-from homing_gym.panorama import DEFAULT_LIGHTING, Lighting, photometric
+from homing_gym.render.panorama import DEFAULT_LIGHTING, Lighting, photometric
 
 
 @dataclass(frozen=True)
@@ -62,7 +62,7 @@ class PerspectiveConfig:
 #: barcode stripes seen obliquely alias: Briggs' fast detector setting (320 x 240) missed
 #: a landmark 2 m away at 45 degrees, and found it from 0 to 60 degrees with 3 x 3
 #: (``docs/benchmark.md``: 2.2 ms -> 22 ms per 320 x 240 view). Panoramas stay at one
-#: ray per pixel (``supersampling`` of :meth:`~homing_gym.raycast.RayCaster.panorama`).
+#: ray per pixel (``supersampling`` of :meth:`~homing_gym.render.raycast.RayCaster.panorama`).
 VIEW_SUPERSAMPLING = 3
 
 
@@ -73,7 +73,7 @@ def render_perspective(client: BulletClient, pose, camera_height: float,
     """The view from ``pose = (x, y, yaw)`` (metres, radians) at ``camera_height``
     metres: uint8 ``(height, width, 3)``. ``lighting`` as for the panorama (``None``:
     the default), including its brightness/contrast change. With a ``caster``
-    (:class:`~homing_gym.raycast.RayCaster`) the view is ray cast instead of rendered by
+    (:class:`~homing_gym.render.raycast.RayCaster`) the view is ray cast instead of rendered by
     PyBullet, :data:`VIEW_SUPERSAMPLING` squared rays per pixel spread evenly over it."""
     if caster is not None:
         return caster.perspective(pose, camera_height, config.width, config.height,
