@@ -1,4 +1,5 @@
-"""The package layers: homing_train -> homing_baselines -> homing_gym, no import cycles.
+"""The package layers: homing_train -> homing_baselines -> homing_gym, no import cycles;
+inside homing_gym, the env core -> sim -> render -> scenes (PARTS).
 
 Every module of the three installed packages is parsed (``ast``; imports inside functions
 and under ``TYPE_CHECKING`` count too) and its imports of the three packages become edges
@@ -15,6 +16,18 @@ import pytest
 
 PACKAGES = ("homing_gym", "homing_baselines", "homing_train")
 LAYER = {"homing_gym": 0, "homing_baselines": 1, "homing_train": 2}
+#: Top-level modules of homing_gym that every part may use: helpers with no world, camera
+#: or episode of their own.
+SHARED = {"homing_gym.cli", "homing_gym.geometry", "homing_gym.native_output",
+          "homing_gym.selfsimilar", "homing_gym.validation", "homing_gym.vision"}
+#: The parts of homing_gym below the env core, each with the parts it may import (besides
+#: itself and SHARED): scenes <- render <- sim <- env core (env, envs, tasks, ...).
+PARTS = {"homing_gym.scenes": set(), "homing_gym.render": {"homing_gym.scenes"},
+         "homing_gym.sim": {"homing_gym.scenes", "homing_gym.render"}}
+#: The modules of homing_gym that import PyBullet: the package (its banner silenced once),
+#: the simulated world, and the two TinyRenderer bridges of the renderer.
+PYBULLET_USERS = {"homing_gym", "homing_gym.sim.simulator", "homing_gym.sim.robot",
+                  "homing_gym.render.panorama", "homing_gym.render.perspective"}
 
 
 def _modules() -> dict[str, str]:
@@ -92,6 +105,38 @@ def test_tasks_never_reach_the_env(graph):
     tasks = [m for m in g if m.startswith("homing_gym.tasks")]
     reached = {m for t in tasks for m in nx.descendants(g, t)}
     assert "homing_gym.env" not in reached and "homing_gym.sim.simulator" not in reached
+
+
+def _part(module: str) -> str | None:
+    """The part of homing_gym (a PARTS key, or "shared") that ``module`` belongs to."""
+    if module in SHARED:
+        return "shared"
+    return next((part for part in PARTS if module == part or module.startswith(part + ".")),
+                None)
+
+
+def test_render_sim_and_scenes_never_import_the_env_core(graph):
+    assert {"homing_gym.render.raycast", "homing_gym.sim.simulator",
+            "homing_gym.scenes.solids"} <= set(graph)
+    allowed = {part: {part, "shared"} | below for part, below in PARTS.items()}
+    allowed["shared"] = {"shared"}
+    wrong = [(a, b) for a, b in graph.edges
+             if _part(a) and b.startswith("homing_gym") and _part(b) not in allowed[_part(a)]]
+    assert wrong == [], f"imports out of the parts (scenes <- render <- sim <- core): {wrong}"
+
+
+def test_only_the_world_and_the_tinyrenderer_bridges_import_pybullet():
+    users = set()
+    for module, path in _modules().items():
+        if module.startswith("homing_gym"):
+            tree = ast.parse(open(path).read(), path)
+            names = [alias.name for node in ast.walk(tree) if isinstance(node, ast.Import)
+                     for alias in node.names]
+            names += [node.module or "" for node in ast.walk(tree)
+                      if isinstance(node, ast.ImportFrom)]
+            if any(n.split(".")[0] in ("pybullet", "pybullet_utils") for n in names):
+                users.add(module)
+    assert users == PYBULLET_USERS
 
 
 def test_generic_top_level_names_are_not_installed(tmp_path):
