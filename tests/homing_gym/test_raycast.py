@@ -248,7 +248,7 @@ def test_cast_shadows_darken_the_floor_behind_an_object_and_nothing_else(make_en
 def test_texture_samples_wrap_round_the_edges(monkeypatch, float64_bytes):
     """Bilinear samples on the edge of a texture blend in the texels of the opposite edge
     (the atlas stores each level with a wrapped border), in float32 and float64 atlases."""
-    from homing_gym import raycast
+    from homing_gym.render import raycast
     from homing_gym.render.column_cast import _texel
 
     monkeypatch.setattr(raycast, "ATLAS_FLOAT64_BYTES", float64_bytes)
@@ -272,7 +272,7 @@ def test_texture_samples_wrap_round_the_edges(monkeypatch, float64_bytes):
 def test_a_float32_atlas_gives_the_pixels_of_a_float64_one(monkeypatch):
     """Worlds with large textures keep their atlas in float32 (half the memory): the
     same values, so the same pixels."""
-    from homing_gym import raycast
+    from homing_gym.render import raycast
 
     env = gym.make("homing_gym/LocalHoming-v0", scene="hallway")
     env.reset(seed=0)
