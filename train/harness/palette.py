@@ -23,10 +23,8 @@ _FIXED = {"oracle": "black", "random": "grey", "snapshot": "orange", "warping": 
           "bearing-complementary": "wine", "bearing-longrange": "indigo",
           "selfsimilar": "olive", "multires": "teal",
           # the shipped learned policies (train/shipped/)
-          "ppo_localhoming": "vermillion", "ppo_procedural_imitation": "green",
-          "ppo_procedural": "sand", "ppo_procedural_arena": "brown",
-          "ppo_procedural_fast": "forest", "ppo_procedural_long": "plum"}
-_SPARE = ("vermillion", "sand", "green")
+          "ppo_procedural_long": "plum", "ppo_procedural_imitation": "green"}
+_SPARE = ("vermillion", "sand", "brown", "forest")
 #: Marker colours of the maps (RGB 0-255), used by no method: home a dark navy ring, the
 #: start a light grey ring.
 HOME_MARK = (20, 20, 120)

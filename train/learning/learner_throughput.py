@@ -12,7 +12,7 @@ env that costs nothing (:class:`FreeVecEnv`), and times SB3's own ``PPO.learn`` 
 :mod:`homing_gym`, so it runs on a machine where only torch and stable-baselines3 are
 installed::
 
-    python -m homing_train.learning.learner_throughput --policy train/shipped/ppo_procedural.zip \\
+    python -m homing_train.learning.learner_throughput --policy train/shipped/ppo_procedural_long.zip \\
         --device cuda --n-envs 8 64 256 --batch-size 256 1024
 
 Network cost does not depend on pixel values, so random observations time the same
@@ -164,7 +164,7 @@ def main(argv: list[str] | None = None) -> int:
         prog="python -m homing_train.learning.learner_throughput",
         description="Time a saved policy's network as a PPO learner, envs taken out "
                     "(random observations of its spaces), on any torch device.")
-    parser.add_argument("--policy", default="train/shipped/ppo_procedural.zip",
+    parser.add_argument("--policy", default="train/shipped/ppo_procedural_long.zip",
                         help="SB3 PPO zip whose network and spaces are timed")
     parser.add_argument("--device", nargs="+", default=["cpu"], help="torch devices, e.g. cpu cuda")
     parser.add_argument("--n-envs", type=int, nargs="+", default=[8])

@@ -2,16 +2,16 @@
 
     homing-train --env homing_gym/LocalHoming-v0 --seed 0 --timesteps 300000 --out runs/ppo
     homing-train --resume runs/ppo          # continue from the last checkpoint
-    homing-train --recipe ppo_procedural_fast --seed 1 --out runs/fast_s1   # a shipped recipe
+    homing-train --recipe ppo_procedural_long --seed 1 --out runs/long_s1   # a shipped recipe
 
 Hyperparameters come from ``train/learning/hyperparams/ppo.yml`` (keyed by env id, with a
 ``default`` entry), or ``--hyperparams FILE``, or ``--recipe NAME`` (the settings a shipped
-policy was trained with, recorded in its ``.yml``), then ``--hp KEY=VALUE`` (values parsed
-as YAML), then the dedicated flags. A run folder holds ``model.zip`` (final),
-``best_model.zip`` and ``evaluations.npz`` (``EvalCallback`` on held-out seeds, with
-success rates), ``checkpoints/``, ``config.yml``, ``command.txt``, ``versions.json``,
-``summary.json`` (timesteps, wall time, env steps per second of ``learn()``),
-TensorBoard logs in ``tb/`` and ``learning_curve.png``; with a ``curriculum``,
+policy, or one shipped before, was trained with, recorded in its ``.yml``), then ``--hp
+KEY=VALUE`` (values parsed as YAML), then the dedicated flags. A run folder holds
+``model.zip`` (final), ``best_model.zip`` and ``evaluations.npz`` (``EvalCallback`` on
+held-out seeds, with success rates), ``checkpoints/``, ``config.yml``, ``command.txt``,
+``versions.json``, ``summary.json`` (timesteps, wall time, env steps per second of
+``learn()``), TensorBoard logs in ``tb/`` and ``learning_curve.png``; with a ``curriculum``,
 ``curriculum.json`` (the stages reached and when).
 
 A new run needs a new or empty ``--out`` (an existing run is continued with ``--resume``),
@@ -37,6 +37,7 @@ import time
 import traceback
 import zipfile
 import zlib
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field, fields
 from functools import partial
 from importlib import resources
@@ -63,6 +64,8 @@ from homing_train.learning.pretrain import pretrain
 from homing_train.outputs import OutputLock, atomic_path, checked_output_dir, write_text_atomic
 
 HYPERPARAMS = Path(str(resources.files("homing_train.learning") / "hyperparams" / "ppo.yml"))
+#: The records (``NAME.yml``) of policies no longer shipped, for ``--recipe NAME``.
+RECIPES = Path(str(resources.files("homing_train.learning") / "recipes"))
 EVAL_SEED_OFFSET = 1_000_000
 IMITATION_SEED_OFFSET = 2_000_000
 PRETRAIN_SEED_OFFSET = 3_000_000
@@ -234,17 +237,18 @@ def load_hyperparams(env_id: str, path: Path = HYPERPARAMS) -> dict[str, Any]:
     return {**entries["default"], **entries[env_id]}
 
 
-def recipe(name: str, folder: Path | None = None) -> tuple[str, dict[str, Any]]:
+def recipe(name: str, folders: Sequence[Path] | None = None) -> tuple[str, dict[str, Any]]:
     """The env id and the settings (as :func:`make_config` takes them: PPO's keys at the top
-    level) that the shipped policy ``name`` was trained with: the ``config`` recorded in
-    ``train/shipped/NAME.yml`` (``folder``: another folder of shipped policies)."""
+    level) that the policy ``name`` was trained with: the ``config`` recorded in
+    ``train/shipped/NAME.yml`` (a shipped policy) or ``train/learning/recipes/NAME.yml``
+    (one no longer shipped); ``folders``: other folders of such records."""
     from homing_train.harness.policies import POLICY_DIR
 
-    folder = POLICY_DIR if folder is None else folder
-    recorded = {p.stem: p for p in sorted(folder.glob("*.yml"))}
+    folders = (POLICY_DIR, RECIPES) if folders is None else folders
+    recorded = {p.stem: p for folder in folders for p in sorted(Path(folder).glob("*.yml"))}
     if name not in recorded:
-        raise ValueError(f"unknown recipe {name!r}; allowed (shipped policies): "
-                         f"{sorted(recorded)}")
+        raise ValueError(f"unknown recipe {name!r}; allowed (shipped policies and the "
+                         f"recipes of earlier ones): {sorted(recorded)}")
     config = (yaml.safe_load(recorded[name].read_text()) or {}).get("config")
     if not isinstance(config, dict) or "env_id" not in config:
         raise ValueError(f"{recorded[name]} records no training config (no 'config' with an "
@@ -858,10 +862,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--hyperparams", type=Path, default=HYPERPARAMS,
                         help="YAML file keyed by env id")
     parser.add_argument("--recipe", metavar="NAME",
-                        help="start from the settings the shipped policy NAME was trained "
-                             "with (its env, envs, network, PPO settings, curriculum), "
-                             "e.g. ppo_procedural_long, the default learned policy; --hp "
-                             "and the flags override them")
+                        help="start from the settings the policy NAME was trained with "
+                             "(its env, envs, network, PPO settings, curriculum), e.g. "
+                             "ppo_procedural_long, the default learned policy, or a policy "
+                             "shipped before (ppo_procedural_fast); --hp and the flags "
+                             "override them")
     parser.add_argument("--hp", action="append", default=[], metavar="KEY=VALUE",
                         help="override a hyperparameter (YAML value); repeatable")
     parser.add_argument("--env-kwargs", type=json.loads, help="JSON kwargs of gym.make")

@@ -317,12 +317,12 @@ def test_missing_training_extra_is_one_line_and_the_suite_runs_without_it(monkey
     assert err.count("\n") == 0 and 'pip install "homing-gym[train]"' in err
     suite.run_suite(tmp_path, episodes=1, workers=1, methods=["random"])
     out = capsys.readouterr().out
-    assert "learned rows ['ppo_localhoming', 'ppo_procedural', 'ppo_procedural_arena', 'ppo_procedural_fast', 'ppo_procedural_imitation', 'ppo_procedural_long'] are left out" in out
-    assert not (tmp_path / "ppo_localhoming.json").exists()
+    assert "learned rows ['ppo_procedural_imitation', 'ppo_procedural_long'] are left out" in out
+    assert not (tmp_path / "ppo_procedural_long.json").exists()
 
 
 def test_the_suite_gives_a_shipped_policy_the_controllers_time(monkeypatch, tmp_path):
-    """ppo_procedural trained with 200 steps of 0.2 s; beside the controllers' 500 steps
+    """ppo_procedural_long trained with 200 steps of 0.2 s; beside the controllers' 500 steps
     of 0.1 s it gets 250 of its own, not the 200 of its record."""
     from homing_train.harness import suite
 
@@ -334,14 +334,14 @@ def test_the_suite_gives_a_shipped_policy_the_controllers_time(monkeypatch, tmp_
 
     monkeypatch.setattr(suite, "evaluate", fake_evaluate)
     with pytest.raises(KeyboardInterrupt):
-        suite.run_suite(tmp_path, episodes=1, workers=1, methods=["ppo_procedural"])
+        suite.run_suite(tmp_path, episodes=1, workers=1, methods=["ppo_procedural_long"])
     (kwargs,) = seen.values()
     assert kwargs["control_period"] == 0.2 and kwargs["max_episode_steps"] == 250
 
 
 @pytest.mark.parametrize("rule", ["stop", "reach"])
 def test_every_row_of_the_suite_has_one_success_rule(monkeypatch, tmp_path, rule):
-    # ppo_procedural trained with success_on="stop"; a controller row has no rule of its
+    # ppo_procedural_long trained with success_on="stop"; a controller row has no rule of its
     # own: both get the suite's
     from homing_train.harness import suite
 
@@ -360,10 +360,10 @@ def test_every_row_of_the_suite_has_one_success_rule(monkeypatch, tmp_path, rule
     monkeypatch.setattr(suite, "evaluate", fake_evaluate)
     monkeypatch.setattr(suite, "format_summary", lambda result: "")
     with pytest.raises(KeyboardInterrupt):
-        suite.run_suite(tmp_path, episodes=1, workers=1, methods=["warping", "ppo_procedural"],
-                        success_on=rule)
+        suite.run_suite(tmp_path, episodes=1, workers=1,
+                        methods=["warping", "ppo_procedural_long"], success_on=rule)
     assert {name: kwargs["success_on"] for name, kwargs in seen.items()} == {
-        "warping": rule, "ppo_procedural.zip": rule}
+        "warping": rule, "ppo_procedural_long.zip": rule}
 
 
 def _without_wall_time(result):

@@ -123,8 +123,8 @@ def test_local_common_starts_in_no_world_a_training_env_started_in():
 def test_policies_expand_to_the_shipped_policies_of_the_protocols_env():
     methods = cell_methods(protocol("local-common"))
     assert "policies" not in methods and "oracle" in methods
-    assert "ppo_localhoming" in methods
-    assert "ppo_localhoming" not in cell_methods(protocol("briggs-corridors"))
+    assert "ppo_procedural_long" in methods
+    assert "ppo_procedural_long" not in cell_methods(protocol("briggs-corridors"))
 
 
 def test_reached_counts_episodes_that_came_within_the_radius_at_any_time():

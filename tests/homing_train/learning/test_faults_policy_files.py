@@ -3,10 +3,13 @@ allocated, every malformed field is one ValueError naming the file, the field an
 bound; ``--trust-policy`` loads zips pickled under the package's old name; a run folder's
 ``config.yml`` is read as checked plain YAML."""
 
+import base64
 import io
 import json
+import pickle
 import subprocess
 import sys
+import types
 import zipfile
 
 import pytest
@@ -18,7 +21,7 @@ from homing_train.learning import policy_zip
 from homing_train.learning.policy_zip import (PolicyFileError, UntrustedPolicyError,
                                               load_policy)
 
-SOURCE = POLICY_DIR / "ppo_procedural_fast.zip"   # the smallest shipped zip
+SOURCE = POLICY_DIR / "ppo_procedural_long.zip"   # the smallest shipped zip
 BIG_BOX = "Box(0, 255, (100000, 100000, 3), uint8)"   # 30 GB as the envs' uint8 images
 SMALL_BOX = "Box(0, 255, (3, 16, 64), uint8)"
 
@@ -179,12 +182,42 @@ def test_malformed_fields_are_one_clear_error_naming_file_and_field(tmp_path, ed
     assert str(caught.value).startswith(path)
 
 
-@pytest.mark.parametrize("name", sorted(p.stem for p in POLICY_DIR.glob("*.zip")))
-def test_every_shipped_policy_loads_with_and_without_trust_policy(name):
-    """``--trust-policy`` reads ``ppo_localhoming.zip`` too, whose pickle names the
-    extractor by the package's old module name (``train.extractor``); both loads give
-    the same weights and spaces."""
-    path = POLICY_DIR / f"{name}.zip"
+def old_module_zip(folder, monkeypatch) -> str:
+    """:data:`SOURCE` as homing-gym 0.1 saved zips: its pickled ``policy_kwargs`` name the
+    extractor by the package's old module name (``train.extractor``)."""
+    with zipfile.ZipFile(SOURCE) as source:
+        members = {name: source.read(name) for name in source.namelist()}
+    doc = json.loads(members["data"])
+    kwargs = pickle.loads(base64.b64decode(doc["policy_kwargs"][":serialized:"]))
+    extractor = kwargs["features_extractor_class"]
+    old = types.ModuleType("train.extractor")
+    setattr(old, extractor.__name__, extractor)
+    with monkeypatch.context() as patch:      # pickle names a class by its __module__
+        patch.setitem(sys.modules, "train", types.ModuleType("train"))
+        patch.setitem(sys.modules, "train.extractor", old)
+        patch.setattr(extractor, "__module__", "train.extractor")
+        pickled = pickle.dumps(kwargs)
+    assert b"train.extractor" in pickled and b"homing_train" not in pickled
+    doc["policy_kwargs"].update({
+        ":serialized:": base64.b64encode(pickled).decode(),
+        "features_extractor_class": f"<class 'train.extractor.{extractor.__name__}'>"})
+    members["data"] = json.dumps(doc).encode()
+    path = folder / "old_module.zip"
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as out:
+        for name, payload in members.items():
+            out.writestr(name, payload)
+    return str(path)
+
+
+@pytest.mark.parametrize("name", [*sorted(p.stem for p in POLICY_DIR.glob("*.zip")),
+                                  "old_module"])
+def test_every_shipped_policy_loads_with_and_without_trust_policy(name, tmp_path,
+                                                                  monkeypatch):
+    """Both loads give the same weights and spaces; ``--trust-policy`` reads a zip of
+    homing-gym 0.1 too (``old_module``), whose pickle names the extractor by the
+    package's old module name (``train.extractor``)."""
+    path = (old_module_zip(tmp_path, monkeypatch) if name == "old_module"
+            else POLICY_DIR / f"{name}.zip")
     safe, trusted = load_policy(path), load_policy(path, trust=True)
     assert safe.observation_space == trusted.observation_space
     assert safe.action_space == trusted.action_space

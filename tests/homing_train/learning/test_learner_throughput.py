@@ -11,7 +11,7 @@ from gymnasium import spaces
 
 from homing_train.learning.learner_throughput import FreeVecEnv, main, measure_learner
 
-SHIPPED = str(resources.files("homing_train") / "shipped" / "ppo_procedural.zip")
+SHIPPED = str(resources.files("homing_train") / "shipped" / "ppo_procedural_long.zip")
 
 
 def test_free_envs_serve_observations_of_the_spaces_and_end_episodes_on_time():

@@ -13,7 +13,7 @@ from homing_train.harness.policies import policy_spec
 from homing_train.harness.policies import POLICY_DIR
 from homing_train.learning.policy_zip import UntrustedPolicyError, load_policy
 
-SHIPPED = POLICY_DIR / "ppo_localhoming.zip"
+SHIPPED = POLICY_DIR / "ppo_procedural_long.zip"
 
 
 class _Payload:
@@ -42,7 +42,7 @@ def _zip_with(tmp_path, edit) -> str:
 
 def test_shipped_policy_loads_without_unpickling_and_keeps_its_weights():
     loaded = load_policy(SHIPPED)
-    assert loaded.observation_space["panorama"].shape == (3, 32, 128)
+    assert loaded.observation_space["panorama"].shape == (3, 16, 64)
     assert loaded.action_space.n == 4
     with zipfile.ZipFile(SHIPPED) as archive:
         import io
@@ -50,7 +50,7 @@ def test_shipped_policy_loads_without_unpickling_and_keeps_its_weights():
     state = loaded.policy.state_dict()
     assert set(state) == set(saved)
     assert all(torch.equal(state[k], saved[k]) for k in saved)
-    obs = {k: np.zeros((32, 128, 3), np.uint8) for k in ("panorama", "goal")}
+    obs = {k: np.zeros((16, 64, 3), np.uint8) for k in ("panorama", "goal")}
     action, _ = loaded.predict(obs, deterministic=True)
     assert int(action) in range(4)
 

@@ -92,9 +92,11 @@ def test_training_never_draws_held_out_worlds_or_its_own_evaluation_worlds():
     import yaml
 
     from homing_train.learning.train import TrainConfig, check_seed_ranges, seed_ranges
-    shipped = sorted(Path(__file__).parents[3].glob("train/shipped/*.yml"))
+    root = Path(__file__).parents[3]
+    shipped = sorted([*root.glob("train/shipped/*.yml"),
+                      *root.glob("train/learning/recipes/*.yml")])
     assert shipped
-    for path in shipped:                       # every shipped run passes, from the start
+    for path in shipped:              # every run shipped now or before passes, from the start
         recorded = yaml.safe_load(path.read_text())["config"]
         config = TrainConfig(**{**recorded, "init_policy": None})   # a file of its machine
         check_seed_ranges(config, 0)
@@ -123,8 +125,14 @@ def test_hyperparameters_merge_and_reject_unknown_keys(tmp_path):
         load_hyperparams("homing_gym/LocalHoming-v0", bad)
 
 
-def test_a_shipped_recipe_rebuilds_the_config_its_policy_was_trained_with(tmp_path, capsys):
-    recorded = yaml.safe_load(Path("train/shipped/ppo_procedural_fast.yml").read_text())
+def test_a_recipe_rebuilds_the_config_its_policy_was_trained_with(tmp_path, capsys):
+    """A shipped policy's recipe and one of a policy no longer shipped (its zip left the
+    package, its record moved to train/learning/recipes/)."""
+    shipped = yaml.safe_load(Path("train/shipped/ppo_procedural_long.yml").read_text())
+    env_id, settings = recipe("ppo_procedural_long")
+    assert asdict(make_config(env_id, settings)) == shipped["config"]
+    assert not Path("train/shipped/ppo_procedural_fast.zip").exists()
+    recorded = yaml.safe_load(Path("train/learning/recipes/ppo_procedural_fast.yml").read_text())
     env_id, settings = recipe("ppo_procedural_fast")
     assert env_id == "homing_gym/LocalHoming-v0" and settings["n_steps"] == 64
     config = make_config(env_id, settings)
@@ -135,7 +143,7 @@ def test_a_shipped_recipe_rebuilds_the_config_its_policy_was_trained_with(tmp_pa
         recipe("ppo_fast")
     (tmp_path / "old.yml").write_text("env_id: homing_gym/LocalHoming-v0\n")
     with pytest.raises(ValueError, match="old.yml records no training config"):
-        recipe("old", tmp_path)
+        recipe("old", [tmp_path])
     for bad in (["--recipe", "ppo_procedural_fast", "--env", "homing_gym/RouteFollowing-v0"],
                 ["--recipe", "ppo_procedural_fast", "--resume", str(tmp_path)],
                 ["--recipe", "ppo_procedural_fast", "--hyperparams", str(tmp_path / "old.yml")],
