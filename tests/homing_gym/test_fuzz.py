@@ -148,7 +148,7 @@ BAD_COMMANDS = [   # (module of the command, arguments)
                                            "{tmp}/r.json"]),
 ]
 #: Policy files from others that command cases name as ``{tmp}/NAME``: the shipped
-#: ppo_procedural_fast.zip's data and weights with ``data[entry][key] = value``, or as
+#: ppo_procedural_long.zip's data and weights with ``data[entry][key] = value``, or as
 #: shipped (``None``) in a run folder whose ``config.yml`` is not YAML.
 POLICY_FILES = {
     "huge_obs.zip": ("observation_space", "spaces", "{'goal': Box(0, 255, (100000, 100000, "
@@ -220,7 +220,7 @@ def write_policy_files(folder: str) -> None:
     """The files of :data:`POLICY_FILES` under ``folder``."""
     from homing_train.harness.policies import POLICY_DIR
 
-    with zipfile.ZipFile(POLICY_DIR / "ppo_procedural_fast.zip") as source:
+    with zipfile.ZipFile(POLICY_DIR / "ppo_procedural_long.zip") as source:
         data, weights = json.loads(source.read("data")), source.read("policy.pth")
     os.makedirs(os.path.join(folder, "run"))
     with open(os.path.join(folder, "run", "config.yml"), "w") as config:
