@@ -1,31 +1,43 @@
-"""``homing-suite``: the package's main job, the comparison of every method on one suite.
+"""``homing-suite``: the package's main job, the comparison of every method.
 
-    homing-suite                       # 20 episodes of LocalHoming-v0, seed 0, into results/
-    homing-suite --episodes 200 --workers 2 --out results/full
+    homing-suite                # the headline: held-out worlds and the papers' protocols
+    homing-suite --episodes 20 --out results/headline
+    homing-suite --protocols all --workers 2 --out results/matrix
+    homing-suite --arena        # every method on LocalHoming-v0 in Yu & Kim's arena
     homing-suite --scene mesh:world.obj --env-kwargs '{"max_episode_steps": 300}'
 
-Evaluates every registered scripted controller made for the env and its scene
-(:func:`suite_methods`) and every shipped PPO policy trained on the env
+With no arguments it runs the headline comparison
+(:mod:`homing_train.harness.headline`): the held-out worlds (``unseen``,
+``local-common``) and the papers' protocols, every classical method where it applies
+and the default learned policy (``ppo_procedural_long``), a few episodes per protocol
+(about 4 minutes on 2 cores); it prints the methods x protocols table (success with 95%
+intervals and the episodes per cell) and a reading of it, and writes the matrix files
+and each cell's files into ``--out``. ``--episodes N`` runs N per setting of every protocol instead,
+``--methods`` a subset (a shipped policy by name too).
+
+``--protocols NAME ...`` (``all``: every protocol, the paper-like counts) runs every
+applicable method on each protocol (:mod:`homing_train.harness.protocols`, one success
+rule: stopped within the radius) and writes the methods x protocols matrix
+(:mod:`homing_train.harness.matrix`): ``matrix.md`` (printed; every cell with the
+``homing-eval --protocol`` command that reproduces it), ``.csv``, ``.json``, ``.png``.
+
+``--arena``, or any of ``--env``/``--env-kwargs``/``--scene``/``--success-on``, runs the
+one-env comparison instead: every registered scripted controller made for the env and
+its scene (:func:`suite_methods`) and every shipped PPO policy trained on the env
 (``train/shipped/*.zip`` with the evaluation settings of its ``*.yml``:
 ``eval_env_kwargs``, ``eval_params``, and the controllers' time:
 :func:`~homing_train.harness.matrix.equal_time_kwargs`), every row under the same
 ``--env-kwargs``/``--scene``, with the same harness on the same seeded episodes (episode
-``i`` uses seed ``seed + i``), writes one ``<method>.json``/``.csv`` per method into
-``--out``, then runs ``homing-compare`` on them:
+``i`` uses seed ``seed + i``; default 20 episodes of LocalHoming-v0 in its default scene,
+Yu & Kim's arena with homes anywhere), writes one ``<method>.json``/``.csv`` per method
+into ``--out``, then runs ``homing-compare`` on them:
 ``table.md`` (printed), ``success_vs_distance.png``, ``final_distance.png`` and
 ``trajectories.png``.
-
-    homing-suite --protocols all --workers 2 --out results/matrix
-    homing-suite --protocols yukim bekris-lab --episodes 100
-
-runs every applicable method on each protocol (:mod:`homing_train.harness.protocols`,
-one success rule: stopped within the radius) and writes the methods x protocols matrix
-(:mod:`homing_train.harness.matrix`): ``matrix.md`` (printed; every cell with the
-``homing-eval --protocol`` command that reproduces it), ``.csv``, ``.json``, ``.png``.
 """
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 from typing import Any
@@ -40,12 +52,17 @@ from homing_train.harness.compare import compare
 from homing_train.harness.evaluate import (DEFAULT_ENV, add_backend_arguments,
                                            check_backend_arguments, check_env_id,
                                            evaluate, format_summary, stream_path)
+from homing_train.harness.headline import (LEARNED, check_methods, headline_plan,
+                                           headline_table, reading)
 from homing_train.harness.matrix import (BASE_PERIOD, applicable, equal_time_kwargs,
                                          matrix_markdown, run_matrix)
 from homing_train.harness.policies import shipped_policies
 from homing_train.harness.protocols import PROTOCOLS, protocol
 from homing_train.outputs import OutputLock, output_dir_argument
 from homing_train.pool import WorkerDiedError, end_stopped_command
+
+#: ``--workers``' default: 2 where the machine has 2 cores or more.
+DEFAULT_WORKERS = min(2, os.cpu_count() or 1)
 
 def suite_methods(env_id: str, env_kwargs: dict[str, Any] | None = None) -> list[str]:
     """The registered controllers made for ``env_id`` in the scene that ``env_kwargs``
@@ -126,20 +143,34 @@ def main(argv: list[str] | None = None) -> int:
     parser = command_parser("homing-suite", __doc__)
     parser.add_argument("--protocols", nargs="+", metavar="NAME",
                         help="run the methods x protocols matrix on these protocols ('all': "
-                        f"every one of {sorted(PROTOCOLS)}) instead of the one-env suite; "
+                        f"every one of {sorted(PROTOCOLS)}) instead of the headline's; "
                         "--episodes then counts per setting (default: each protocol's)")
+    parser.add_argument("--arena", action="store_true",
+                        help="the one-env comparison instead of the headline: every method "
+                        f"on --env (default {DEFAULT_ENV} in its default scene, Yu & Kim's "
+                        "arena, homes anywhere); --env, --env-kwargs, --scene or "
+                        "--success-on select it too")
     add_env_arguments(parser, DEFAULT_ENV)
+    parser.set_defaults(env=None)        # given or not: it selects the one-env comparison
     parser.add_argument("--episodes", type=int, default=None,
-                        help="episodes per method (default 20; see --protocols)")
+                        help="episodes per setting of every protocol (default: the "
+                        "headline's few, each protocol's own with --protocols); with "
+                        "--arena per method (default 20)")
     parser.add_argument("--seed", type=seed_value, default=None,
                         help="seed of the first episode (default 0); with --protocols the "
                         "base seed of every protocol's episode draw instead of its own (not "
                         "the canonical draw: each cell's command then carries --seed)")
-    parser.add_argument("--workers", type=worker_count, default=2, help="parallel processes")
-    parser.add_argument("--methods", nargs="+", help="subset of methods (default: all)")
-    parser.add_argument("--success-on", choices=("stop", "reach"), default="stop",
-                        help="the success rule of every row (without --protocols): stopped at "
-                        "the goal, or came within its radius at any time")
+    parser.add_argument("--workers", type=worker_count, default=DEFAULT_WORKERS,
+                        help=f"parallel processes (default {DEFAULT_WORKERS}: 2, or 1 on a "
+                        "one-core machine)")
+    parser.add_argument("--methods", nargs="+",
+                        help="subset of methods (default: every classical method where it "
+                        f"applies and the default learned policy, {LEARNED}; with --arena or "
+                        "--protocols every shipped policy too)")
+    parser.add_argument("--success-on", choices=("stop", "reach"), default=None,
+                        help="the success rule of every row of the one-env comparison "
+                        "(default stop): stopped at the goal, or came within its radius at "
+                        "any time; the protocols' rule is stop")
     parser.add_argument("--out", default="results", type=output_dir_argument,
                         help="output folder (default: results)")
     parser.add_argument("--resume", action="store_true",
@@ -152,11 +183,17 @@ def main(argv: list[str] | None = None) -> int:
     check_backend_arguments(parser, args)
     if args.episodes is not None and args.episodes < 1:
         parser.error("--episodes must be >= 1")
-    if args.protocols and (args.env != DEFAULT_ENV or args.env_kwargs or args.scene):
-        parser.error("--protocols fix the envs and their kwargs; drop --env/--env-kwargs/--scene")
+    one_env = [flag for flag, value in (("--env", args.env), ("--env-kwargs", args.env_kwargs),
+                                        ("--scene", args.scene),
+                                        ("--success-on", args.success_on)) if value]
+    if args.protocols and (one_env or args.arena):
+        parser.error(f"--protocols fix the envs and their kwargs; drop "
+                     f"{'/'.join(one_env) or '--arena'}")
     try:
         with OutputLock(args.out):      # one run at a time in a folder
-            return _matrix(args) if args.protocols else _suite(args)
+            if args.protocols:
+                return _matrix(args)
+            return _suite(args) if args.arena or one_env else _headline(args)
     except ValueError as err:
         parser.exit(2, f"homing-suite: error: {err}\n")
     except (WorkerDiedError, KeyboardInterrupt) as err:   # Ctrl-C, SIGTERM, SIGHUP too
@@ -178,12 +215,31 @@ def _matrix(args) -> int:
     return 0
 
 
+def _headline(args) -> int:
+    """No ``--protocols`` or one-env option: the headline comparison, its table and
+    reading."""
+    plan = headline_plan(args.episodes, args.methods, args.seed)
+    check_methods(plan)
+    print("homing-suite: the headline comparison (--arena: the one-env comparison; "
+          "--protocols all: every protocol at its own count)\n" + plan.describe())
+    cells = run_matrix(plan.protocols, Path(args.out), plan.episodes, args.workers,
+                       plan.methods, resume=args.resume, backend=args.backend,
+                       address=args.ray_address, by_cell=True)
+    print(headline_table(cells))
+    print(reading(cells))
+    print(f"wrote {args.out}/matrix.md (every cell's command, the papers' claims), "
+          f"matrix.csv, matrix.json, matrix.png, and each cell's files under "
+          f"{args.out}/<protocol>/<method>/")
+    return 0
+
+
 def _suite(args) -> int:
-    """Without ``--protocols``: every method on one env, compared."""
-    written = run_suite(Path(args.out), args.env, 20 if args.episodes is None else args.episodes,
+    """``--arena`` or a one-env option: every method on one env, compared."""
+    written = run_suite(Path(args.out), args.env or DEFAULT_ENV,
+                        20 if args.episodes is None else args.episodes,
                         args.seed or 0, args.workers, args.methods, args.backend,
-                        args.ray_address, args.success_on, env_kwargs_from_args(args),
-                        resume=args.resume)
+                        args.ray_address, args.success_on or "stop",
+                        env_kwargs_from_args(args), resume=args.resume)
     print(Path(written["table"]).read_text())
     print("wrote " + ", ".join(written.values()))
     return 0

@@ -337,7 +337,7 @@ def test_extractor_kwargs_size_the_network_and_bad_ones_are_named():
 def test_suite_evaluates_and_compares_methods_on_one_suite(tmp_path, capsys):
     from homing_train.harness.suite import main as suite_main
 
-    assert suite_main(["--methods", "oracle", "--episodes", "2", "--workers", "1",
+    assert suite_main(["--arena", "--methods", "oracle", "--episodes", "2", "--workers", "1",
                        "--out", str(tmp_path)]) == 0
     table = (tmp_path / "table.md").read_text()
     assert "| oracle |" in table and "table.md" in capsys.readouterr().out
