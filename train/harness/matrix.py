@@ -26,14 +26,16 @@ replace the same protocol and method's cells in it, and its matrix files are rew
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import json
 import os
 import re
 import sys
+import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import Callable, Mapping, Sequence
 
 import gymnasium as gym
 import matplotlib
@@ -52,6 +54,7 @@ from homing_train.harness.metrics import aggregate_success, wilson_interval  # n
 from homing_train.harness.protocols import (POLICIES, PROTOCOLS, Protocol,  # noqa: E402
                                             episodes_key)
 from homing_train.outputs import write_text_atomic  # noqa: E402
+from homing_train.pool import pool_results  # noqa: E402
 
 #: The control period (s) that protocols count ``max_episode_steps`` in.
 BASE_PERIOD = 0.1
@@ -239,29 +242,75 @@ def _scene(setting) -> str | None:
     return getattr(scene, "name", scene)
 
 
-def run_matrix(protocols: Sequence[Protocol], out: Path, episodes: int | None = None,
-               workers: int = 1, methods: Sequence[str] | None = None,
-               progress: bool = True, resume: bool = False, backend: str = "local",
-               address: str | None = None) -> list[Cell]:
+def run_matrix(protocols: Sequence[Protocol], out: Path,
+               episodes: int | Mapping[str, int] | None = None, workers: int = 1,
+               methods: Sequence[str] | None = None, progress: bool = True,
+               resume: bool = False, backend: str = "local", address: str | None = None,
+               by_cell: bool = False) -> list[Cell]:
     """Every applicable method (or those of ``methods`` that apply) on every protocol;
-    cells under ``out/<protocol>/<method>/``, the matrix files in ``out``. With
-    ``resume`` the cells of an earlier ``out/matrix.json`` that were not run again (other
-    methods or protocols) stay in the matrix. Of ``methods``, those that apply to none of
-    ``protocols`` are left out with a note (``ValueError`` if none is left)."""
+    cells under ``out/<protocol>/<method>/``, the matrix files in ``out``; ``episodes``
+    per setting: one count for all, or a count per protocol name (default: each
+    protocol's own). With ``resume`` the cells of an earlier ``out/matrix.json`` that
+    were not run again (other methods or protocols) stay in the matrix. Of ``methods``,
+    those that apply to none of ``protocols`` are left out with a note (``ValueError`` if
+    none is left). ``by_cell`` (local backend): ``workers`` processes run whole cells,
+    each cell's episodes in one of them, a line printed as each cell ends (many small
+    cells: no pool per setting)."""
     if methods:
         methods = applicable(list(methods), {m for p in protocols for m in cell_methods(p)},
                              lambda: "the protocols " + ", ".join(p.name for p in protocols))
-    cells = []
-    for protocol in protocols:
-        for method in cell_methods(protocol):
-            if methods and method not in methods:
-                continue
-            cells.append(run_cell(protocol, method, out / protocol.name / method, episodes,
-                                  workers, progress, resume, backend, address))
+    jobs = [(protocol, method, out / protocol.name / method,
+             episodes.get(protocol.name) if isinstance(episodes, Mapping) else episodes,
+             resume) for protocol in protocols for method in cell_methods(protocol)
+            if not methods or method in methods]
+    if by_cell and backend == "local" and workers > 1:
+        cells = cells_in_parallel(jobs, workers)
+    else:
+        cells = [run_cell(protocol, method, path, n, workers, progress, again, backend,
+                          address) for protocol, method, path, n, again in jobs]
     if resume and (out / "matrix.json").exists():
         cells = merged_cells(load_cells(out / "matrix.json"), cells)
     write_matrix(cells, out)
     return cells
+
+
+def _timed_cell(job: tuple) -> tuple[Cell, float]:
+    """A job of :func:`cells_in_parallel` run in this process: its cell and wall seconds."""
+    protocol, method, path, episodes, resume = job
+    start = time.perf_counter()
+    cell = run_cell(protocol, method, path, episodes, 1, progress=False, resume=resume)
+    return cell, time.perf_counter() - start
+
+
+def job_cost(job: tuple) -> int:
+    """A cell job's most env steps: its episodes times their step cap (what a method that
+    never stops, e.g. ``random``, runs)."""
+    protocol, _, _, episodes, _ = job
+    n = protocol.episodes if episodes is None else episodes
+    return sum(len(s.episode_tasks(n, protocol.seed))
+               * (s.env_kwargs.get("max_episode_steps")
+                  or gym.spec(s.env_id).max_episode_steps or 1)
+               for s in protocol.settings)
+
+
+def cells_in_parallel(jobs: Sequence[tuple], workers: int) -> list[Cell]:
+    """The cells of ``jobs`` (protocol, method, folder, episodes, resume), run by
+    ``workers`` processes, the costliest first (:func:`job_cost`), in ``jobs``' order;
+    one line per cell as it ends, and the sum of the cells' wall times."""
+    order = sorted(range(len(jobs)), key=lambda i: -job_cost(jobs[i]))
+    cells: dict[int, Cell] = {}
+    total = 0.0
+    with contextlib.closing(pool_results(_timed_cell, [jobs[i] for i in order], workers,
+                                         name=lambda job: f"{job[0].name} x {job[1]}")) as done:
+        for index, (cell, seconds) in done:
+            cells[order[index]] = cell
+            total += seconds
+            k = round(cell.summary["success_rate"] * cell.summary["episodes"])
+            print(f"[{len(cells)}/{len(jobs)}] {cell.protocol} x {cell.method}: "
+                  f"{k}/{cell.summary['episodes']} stopped at the goal ({seconds:.0f} s)",
+                  flush=True)
+    print(f"{len(jobs)} cells, {total:.0f} s of cell time in all ({workers} processes)")
+    return [cells[i] for i in range(len(jobs))]
 
 
 def load_cells(path: str | Path) -> list[Cell]:
@@ -493,9 +542,9 @@ def write_matrix(cells: Sequence[Cell], out: Path) -> dict[str, str]:
             "final_distance_mean")
     with open(written["csv"], "w", newline="") as f:
         writer = csv.writer(f)
-        writer.writerow(["protocol", "version", "method", *keys, "command"])
+        writer.writerow(["protocol", "version", "method", "success_on", *keys, "command"])
         for c in cells:
-            writer.writerow([c.protocol, c.version, c.method,
+            writer.writerow([c.protocol, c.version, c.method, c.success_on,
                              *(json.dumps(c.summary[k]) if isinstance(c.summary[k], list)
                                else c.summary[k] for k in keys), c.command])
     if cells:
