@@ -9,6 +9,7 @@ subclasses in :mod:`homing_gym.envs` that choose the task and carry the env card
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 import math
 from typing import Any
@@ -18,39 +19,24 @@ import numpy as np
 from gymnasium import spaces
 
 from homing_gym.actions import DiscreteAction
+from homing_gym.config import EnvConfig, env_config
 from homing_gym.geometry import finite_pose, to_frame
 from homing_gym.observations import CORE_KEYS, ObservationKey, Sight, goal_step_key
-from homing_gym.render.panorama import CameraConfig, Lighting, PanoramaCamera, random_lighting
+from homing_gym.render.panorama import Lighting, PanoramaCamera, random_lighting
 from homing_gym.paths import occupancy
 from homing_gym.render.perspective import PerspectiveConfig, render_perspective
-from homing_gym.sim.robot import RobotConfig, odometry_for
+from homing_gym.sim.robot import odometry_for
 from homing_gym.scenes import scene_factory
 from homing_gym.scenes.base import Scene, clearance
-from homing_gym.sim.simulator import Simulator, gui_unavailable
+from homing_gym.sim.simulator import Simulator
 from homing_gym.tasks.base import Task
 from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.episode import Episode
 from homing_gym.render.topdown import compose_frame, draw_topdown
-from homing_gym.validation import (is_real, require_number, require_positive,
-                                   require_sequence)
 
-ACTION_TYPES = ("continuous", "discrete")
-#: Where ``odometry`` starts: zero in the start pose's frame (path integration from where
-#: the robot was put), or the start pose in home's frame (a privileged homing vector).
-ODOMETRY_ORIGINS = ("start", "home")
-#: Bounds of the simulation settings: physics sub-steps per control period, the control
-#: period (seconds) and the physics step (seconds; longer steps let the robot pass
-#: through walls, shorter ones only cost time).
-MAX_SUBSTEPS, MAX_CONTROL_PERIOD = 1000, 2.0
-MIN_TIME_STEP, MAX_TIME_STEP = 1 / 2000, 1 / 60
 #: Observation keys the env core provides (tasks may add more): see
 #: :mod:`homing_gym.observations`.
 OBSERVATION_KEYS = (*CORE_KEYS, "goal_step")
-#: Most episodes in one procedural world (``episodes_per_world``): a bound for a counter,
-#: far beyond any training run's need of a fresh world.
-MAX_EPISODES_PER_WORLD = 10**9
-#: Physics sub-steps per control period by default (1/120 s at the default 0.1 s).
-PHYSICS_SUBSTEPS = 12
 #: Grid (metres) on which a new world is checked for room for the robot.
 ROOM_RESOLUTION = 0.05
 
@@ -58,8 +44,8 @@ ROOM_RESOLUTION = 0.05
 def simulation_settings(env_kwargs: dict) -> dict:
     """The renderer and physics sub-steps an env made with ``env_kwargs`` runs with (the
     given ones, else the defaults): what result files record beside the policy."""
-    return {"renderer": env_kwargs.get("renderer", CameraConfig.renderer),
-            "physics_substeps": env_kwargs.get("physics_substeps", PHYSICS_SUBSTEPS)}
+    return {"renderer": env_kwargs.get("renderer", EnvConfig.renderer),
+            "physics_substeps": env_kwargs.get("physics_substeps", EnvConfig.physics_substeps)}
 
 
 def _check_room(scene: Scene, radius: float) -> None:
@@ -72,12 +58,12 @@ def _check_room(scene: Scene, radius: float) -> None:
 
 def check_env_kwargs(env_class: type, kwargs: dict) -> None:
     """``ValueError`` naming the keyword arguments in ``kwargs`` that neither
-    ``env_class.__init__`` nor :class:`HomingEnv` takes, and listing those they do
+    ``env_class.__init__`` nor :class:`HomingEnv` (``scene`` and the fields of
+    :class:`~homing_gym.config.EnvConfig`) takes, and listing those they do
     (instead of Python's ``TypeError``, which names one and lists none)."""
-    names = set()
-    for init in (env_class.__init__, HomingEnv.__init__):
-        names.update(name for name, param in inspect.signature(init).parameters.items()
-                     if param.kind in (param.POSITIONAL_OR_KEYWORD, param.KEYWORD_ONLY))
+    names = {f.name for f in dataclasses.fields(EnvConfig)} | {"scene"}
+    names.update(name for name, param in inspect.signature(env_class.__init__).parameters.items()
+                 if param.kind in (param.POSITIONAL_OR_KEYWORD, param.KEYWORD_ONLY))
     allowed = sorted(names - {"self", "task"})
     unknown = sorted(set(kwargs) - set(allowed))
     if unknown:
@@ -89,129 +75,61 @@ class HomingEnv(gym.Env):
     """A differential-drive robot with a panoramic camera in a PyBullet scene.
 
     See :class:`homing_gym.envs.LocalHomingEnv` for the full description of spaces and
-    arguments; ``task`` is a :class:`~homing_gym.tasks.Task` instance.
+    arguments; ``task`` is a :class:`~homing_gym.tasks.Task` instance, ``settings`` the
+    fields of :class:`~homing_gym.config.EnvConfig` (its defaults where left out).
     """
 
     metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 10}
 
-    def __init__(self, task: Task, scene: str | Scene = "arena", *,
-                 render_mode: str | None = None,
-                 obs_keys: tuple[str, ...] | list[str] = ("panorama", "goal"),
-                 panorama_shape: tuple[int, int] = CameraConfig.panorama_shape,
-                 vfov_deg: float = math.degrees(CameraConfig.vfov),
-                 n_views: int = CameraConfig.n_views, renderer: str = CameraConfig.renderer,
-                 omni_size: int = CameraConfig.omni_size,
-                 supersampling: int = CameraConfig.supersampling,
-                 action_type: str = "continuous", control_period: float = 0.1,
-                 physics_substeps: int = PHYSICS_SUBSTEPS, max_speed: float = RobotConfig.max_speed,
-                 max_yaw_rate: float = RobotConfig.max_yaw_rate, stop_threshold: float = 0.05,
-                 odometry_noise: float = 0.02, odometry_origin: str = "start",
-                 lighting_change: float = 0.0, goal_step_length: float = 0.15,
-                 camera_height: float = RobotConfig.camera_height, drive: str = "differential",
-                 sky_color: tuple[float, float, float] | None = None, shadows: bool = False,
-                 episodes_per_world: int = 1):
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(f"unknown render_mode {render_mode!r}; allowed: "
-                             f"{self.metadata['render_modes']} or None")
-        if render_mode == "human" and (why := gui_unavailable()):
-            raise ValueError(f"render_mode='human' opens PyBullet's GUI, which cannot open "
-                             f"here: {why}; use render_mode='rgb_array' (frames as arrays)")
-        if action_type not in ACTION_TYPES:
-            raise ValueError(f"unknown action_type {action_type!r}; allowed: {ACTION_TYPES}")
-        if odometry_origin not in ODOMETRY_ORIGINS:
-            raise ValueError(f"unknown odometry_origin {odometry_origin!r}; allowed: "
-                             f"{ODOMETRY_ORIGINS}")
-        require_positive("control_period", control_period, "seconds")
-        if control_period > MAX_CONTROL_PERIOD:
-            raise ValueError(f"control_period must be at most {MAX_CONTROL_PERIOD} s, "
-                             f"got {control_period!r}")
-        require_number("physics_substeps", physics_substeps, 1, MAX_SUBSTEPS, integer=True)
-        time_step = control_period / physics_substeps
-        if not MIN_TIME_STEP <= time_step <= MAX_TIME_STEP:
-            raise ValueError(
-                f"control_period {control_period!r} s in {physics_substeps} physics_substeps "
-                f"gives physics steps of {time_step:.3g} s; allowed: steps in "
-                f"[1/{round(1 / MIN_TIME_STEP)}, "
-                f"1/{round(1 / MAX_TIME_STEP)}] s (PyBullet's contacts fail beyond)")
-        require_positive("max_speed", max_speed, "m/s")
-        require_positive("max_yaw_rate", max_yaw_rate, "rad/s")
-        require_number("lighting_change", lighting_change, 0, 1, "(0: off)")
-        require_number("stop_threshold", stop_threshold, 0, 1, high_open=True)
-        require_number("vfov_deg", vfov_deg, 10, 120, "degrees")
-        panorama_shape = require_sequence("panorama_shape", panorama_shape, 2,
-                                          "(H, W) integers")
-        require_number("episodes_per_world", episodes_per_world, 1, MAX_EPISODES_PER_WORLD,
-                       integer=True)
+    def __init__(self, task: Task, scene: str | Scene = "arena", **settings):
+        config = env_config(settings)
         table: dict[str, ObservationKey] = {**CORE_KEYS,
-                                            "goal_step": goal_step_key(goal_step_length),
+                                            "goal_step": goal_step_key(config.goal_step_length),
                                             **task.observation_keys()}
         allowed = tuple(table)
-        keys = tuple(obs_keys) if isinstance(obs_keys, (list, tuple)) else ()
+        keys = config.obs_keys if isinstance(config.obs_keys, tuple) else ()
         if (not keys or any(k not in allowed for k in keys)
                 or len(set(keys)) != len(keys)):
-            raise ValueError(f"bad obs_keys {obs_keys!r}: give a list or tuple of distinct "
-                             f"keys from {allowed}")
-
-        self.render_mode = render_mode
-        self.task = task
-        self.obs_keys = tuple(obs_keys)
-        self.action_type = action_type
-        self.control_period = float(control_period)
-        self.physics_substeps = int(physics_substeps)
-        self.stop_threshold = float(stop_threshold)
-        self.lighting_change = float(lighting_change)
-        self.episodes_per_world = int(episodes_per_world)
-        self._world_episodes_left = 0
-        self.goal_step_length = float(goal_step_length)
-        self._lighting: Lighting | None = None
-        require_number("camera_height", camera_height, 0.005, 5.0, "metres above the floor")
-        if supersampling != CameraConfig.supersampling and renderer != "raycast":
-            raise ValueError(f"supersampling needs renderer='raycast', got "
-                             f"renderer={renderer!r}")
-        if sky_color is not None:
-            if renderer != "raycast":
-                raise ValueError(f"sky_color needs renderer='raycast' (the {renderer!r} "
-                                 f"renderer's background is fixed), got renderer={renderer!r}")
-            what = "three RGB values in [0, 1]"
-            for c in require_sequence("sky_color", sky_color, 3, what):
-                if not (is_real(c) and 0 <= c <= 1):
-                    raise ValueError(f"sky_color must be {what}, got {sky_color!r}")
-        if shadows not in (True, False):
-            raise ValueError(f"shadows must be True or False, got {shadows!r}")
-        if shadows and renderer != "raycast":
-            raise ValueError(f"shadows needs renderer='raycast', got renderer={renderer!r}")
-        if drive == "synchro" and action_type != "continuous":
-            raise ValueError("drive='synchro' takes continuous actions (vx, vy); got "
-                             f"action_type={action_type!r}")
-        if drive == "synchro" and task.drives_robot:
+            raise ValueError(f"bad obs_keys {config.obs_keys!r}: give a list or tuple of "
+                             f"distinct keys from {allowed}")
+        if config.drive == "synchro" and task.drives_robot:
             raise ValueError(f"drive='synchro' is not available in {type(task).__name__}: "
                              f"the task drives the robot itself (unicycle commands)")
-        self.robot_config = RobotConfig(max_speed=float(max_speed),
-                                        max_yaw_rate=float(max_yaw_rate),
-                                        camera_height=float(camera_height), drive=drive)
-        camera_config = CameraConfig(
-            panorama_shape=tuple(panorama_shape), vfov=math.radians(vfov_deg),
-            n_views=n_views, omni_size=omni_size, renderer=renderer,
-            supersampling=supersampling)
-        self.odometry = odometry_for(self.robot_config, odometry_noise)
-        self.odometry_origin = odometry_origin
+
+        #: The env's settings (:class:`~homing_gym.config.EnvConfig`).
+        self.config = config
+        self.render_mode = config.render_mode
+        self.task = task
+        self.obs_keys = config.obs_keys
+        self.action_type = config.action_type
+        self.control_period = config.control_period
+        self.physics_substeps = config.physics_substeps
+        self.stop_threshold = config.stop_threshold
+        self.lighting_change = config.lighting_change
+        self.episodes_per_world = config.episodes_per_world
+        self._world_episodes_left = 0
+        self.goal_step_length = config.goal_step_length
+        self._lighting: Lighting | None = None
+        self.robot_config = config.robot()
+        self.odometry = odometry_for(self.robot_config, config.odometry_noise)
+        self.odometry_origin = config.odometry_origin
         self._scene_factory = scene_factory(scene)
         self.scene = self._scene_factory.build(np.random.default_rng(0))
         _check_room(self.scene, self.robot_config.body_radius)
         task.check_scene(self.scene)
-        self.sim = Simulator(self.scene, gui=render_mode == "human",
+        self.sim = Simulator(self.scene, gui=self.render_mode == "human",
                              time_step=self.control_period / self.physics_substeps,
-                             robot_config=self.robot_config, renderer=renderer,
-                             sky_color=sky_color, shadows=bool(shadows))
+                             robot_config=self.robot_config, renderer=config.renderer,
+                             sky_color=config.sky_color, shadows=config.shadows)
         self.camera = PanoramaCamera(
-            camera_config, self.robot_config.camera_height, renderer=self.sim.renderer,
+            config.camera(), self.robot_config.camera_height, renderer=self.sim.renderer,
             caster=(lambda: self.sim.caster) if self.sim.caster is not None else None,
             vertices=self.sim.world_vertices if self.sim.caster is None else None)
 
         self._table = {k: table[k] for k in self.obs_keys}
         self.observation_space = spaces.Dict(
             {k: entry.space(self.camera.config) for k, entry in self._table.items()})
-        if action_type == "discrete":
+        if config.action_type == "discrete":
             self.action_space = spaces.Discrete(len(DiscreteAction))
         else:
             self.action_space = spaces.Box(-1.0, 1.0, (2,), np.float32)

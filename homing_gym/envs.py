@@ -19,7 +19,25 @@ from homing_gym.tasks import (LocalHomingTask, LongRangeHomingTask, RewardConfig
 from homing_gym.tasks.landmark_navigation import LandmarkNavigationTask
 from homing_gym.tasks.work_locations import MAX_POINTS, TAUGHT_KEYS, WorkLocationsTask
 from homing_gym.teaching import PLACE_SPACING
+from homing_gym.tasks.goal_reaching import MAX_SUCCESS_RADIUS
 from homing_gym.validation import require_number, require_sequence
+
+#: A row of an env card's argument table for a task's own argument: (allowed values,
+#: unit, meaning); the default is the env class's (:mod:`homing_gym.envcard`).
+Row = tuple[str, str, str]
+SCENE: Row = ("a registered scene name, `'mesh:PATH'` (a mesh file) or a `Scene`", "",
+              "the world")
+SUCCESS_ON: Row = ("`'stop'`, `'reach'`", "",
+                   "`'stop'`: the episode ends when the agent issues stop, a success within "
+                   "the goal's radius (the protocols' rule); `'reach'`: it ends, a success, "
+                   "on arrival (see Episode end)")
+SUCCESS_RADIUS: Row = (f"(0, {MAX_SUCCESS_RADIUS:g}]", "metres",
+                       "distance from the goal that counts as arrived")
+REWARD: Row = ("a `RewardConfig`, or a dict of some of its fields, e.g. "
+               "`{'progress': 10.0}`", "", "reward weights (see Rewards)")
+START_JITTER: Row = ("two numbers >= 0, within the room around the start", "metres, radians",
+                     "uniform perturbation of the start in x, y and heading")
+OBS_KEYS: Row = ("distinct keys of the observation space", "", "the observation's keys")
 
 
 class LocalHomingEnv(HomingEnv):
@@ -94,11 +112,16 @@ class LocalHomingEnv(HomingEnv):
 
     ## Episode end
 
-    Terminated on success: with ``success_on="reach"`` (default) when the robot centre is
-    within ``success_radius`` = 0.15 m of home; with ``success_on="stop"`` when the agent
-    issues stop (discrete action 3, or a continuous action with both components below
-    ``stop_threshold`` = 0.05 in magnitude), a success if it stopped within
-    ``success_radius``. Truncated after ``max_episode_steps`` = 500 steps (50 s).
+    With ``success_on="stop"`` (default) terminated when the agent issues stop (discrete
+    action 3, or a continuous action with both components below ``stop_threshold`` = 0.05
+    in magnitude), a success if it stopped within ``success_radius`` = 0.15 m of home;
+    with ``success_on="reach"`` terminated, a success, as soon as the robot centre is
+    within ``success_radius``. Truncated after ``max_episode_steps`` = 500 steps (50 s).
+
+    Why "stop" by default: it is the rule of every protocol, of the matrix and of
+    ``homing-suite``, so an agent's numbers from ``gym.make``'s defaults compare with
+    theirs unless asked otherwise. ``success_on="reach"`` (homing-gym 0.2's default)
+    stays available; every result file of the harness records the rule it used.
 
     ## Info
 
@@ -111,48 +134,25 @@ class LocalHomingEnv(HomingEnv):
 
     ## Arguments
 
-    ``gym.make("homing_gym/LocalHoming-v0", **kwargs)`` with: ``scene`` (``"arena"``;
-    any registered scene name, e.g. ``"random_arena"``, ``"random_rooms"``,
-    ``"random_nature"``; ``"mesh:PATH"`` for a mesh file; a
-    :class:`~homing_gym.scenes.Scene`), ``render_mode``
-    (``None``, ``"rgb_array"``: top-down map beside current and goal panoramas;
-    ``"human"``: PyBullet GUI), ``obs_keys``, ``panorama_shape`` = (48, 256),
-    ``vfov_deg`` = 60, ``n_views`` = 6, ``renderer`` = ``"raycast"`` (exact ray
-    casting through the pixels, textures filtered like a camera's pixels, see
-    :mod:`homing_gym.render.raycast`; ``"tiny"``: PyBullet's TinyRenderer, six perspective views
-    remapped, homing-gym 0.1's default, 2-6x slower; ``"egl"``: PyBullet's OpenGL plugin),
-    ``supersampling`` = 2 (raycast: ``k x k`` rays averaged per panorama pixel, 1-4), ``omni_size`` = 128,
-    ``action_type``, ``control_period`` (at most 2 s), ``physics_substeps`` (1-1000; each
-    physics step between 1/2000 and 1/60 s), ``max_speed``,
-    ``max_yaw_rate``, ``stop_threshold``, ``odometry_noise`` = 0.02,
-    ``odometry_origin`` = ``"start"`` (or ``"home"``), ``drive`` = ``"differential"``
-    (or ``"synchro"``: the body translates without turning, as Hong et al.'s robot; the
-    continuous action is then the body-frame velocity ``(vx, vy)``, speed at most
-    ``max_speed``; see :mod:`homing_gym.sim.robot`), ``goal_step_length`` = 0.15,
-    ``lighting_change`` = 0
-    (0-1: strength of an illumination change between the home snapshot and the run, drawn
-    from the seed: light direction, brightness, contrast),
-    ``camera_height`` = 0.30 (metres above the floor, 0.005-5; below the robot's top,
-    about 0.1 m, use ``renderer="raycast"``, which never sees the robot's own body),
-    ``sky_color`` (RGB in [0, 1] of rays that hit nothing; ``renderer="raycast"`` only),
-    ``shadows`` = False (``renderer="raycast"`` only: objects cast shadows from the scene
-    light, which moves with ``lighting_change``; see :mod:`homing_gym.render.shadows`),
-    ``episodes_per_world`` = 1 (a randomised scene draws a new world on every seeded reset
-    and on every ``episodes_per_world``-th unseeded one: for training, where building a
-    procedural world, 30-70 ms, would dominate short episodes),
-    ``start_distance`` (its minimum at least ``success_radius``), ``success_radius``,
-    ``success_on``, ``reward`` (a
-    ``RewardConfig``, or a dict of some of its fields, e.g. ``{"progress": 10.0}``),
-    ``max_episode_steps``.
+    ``gym.make("homing_gym/LocalHoming-v0", **kwargs)`` with the arguments below and
+    ``max_episode_steps``: the task's, then the env core's, shared by every env id
+    (:class:`~homing_gym.config.EnvConfig`; the table is written from the code).
 
     ## Version history
 
     * v0: initial release.
     """
 
+    ARGUMENTS: dict[str, Row] = {
+        "scene": (SCENE[0] + ", e.g. `'random_arena'`, `'random_rooms'`, `'random_nature'`",
+                  "", SCENE[2]),
+        "start_distance": ("(min, max) with success_radius <= min <= max, fitting the scene",
+                           "metres", "distance of the start from home, drawn uniformly"),
+        "success_radius": SUCCESS_RADIUS, "success_on": SUCCESS_ON, "reward": REWARD}
+
     def __init__(self, scene: str | Scene = "arena", *,
                  start_distance: tuple[float, float] = (0.3, 1.5),
-                 success_radius: float = 0.15, success_on: str = "reach",
+                 success_radius: float = 0.15, success_on: str = "stop",
                  reward: RewardConfig = RewardConfig(), **kwargs):
         check_env_kwargs(type(self), kwargs)
         task = LocalHomingTask(start_distance=start_distance, success_radius=success_radius,
@@ -218,11 +218,11 @@ class RouteFollowingEnv(HomingEnv):
 
     ## Episode end
 
-    ``success_on="reach"`` (default): a target is reached when the robot centre comes
-    within ``success_radius`` = 0.1 m of it. ``success_on="stop"``: the agent signals
-    arrival with the stop action (discrete 3, or both continuous components below
+    ``success_on="stop"`` (default; why: ``LocalHoming-v0``): the agent signals arrival
+    with the stop action (discrete 3, or both continuous components below
     ``stop_threshold``); the target is left whatever the distance, which is recorded as
-    its error. Terminated after the last target; a success if it was reached within
+    its error. ``success_on="reach"``: a target is reached when the robot centre comes
+    within ``success_radius`` = 0.1 m of it. Terminated after the last target; a success if it was reached within
     ``success_radius``. Truncated after 1000 steps.
 
     ## Info
@@ -233,31 +233,37 @@ class RouteFollowingEnv(HomingEnv):
 
     ## Arguments
 
-    ``scene`` (default ``"hallway"``; any scene with ``metadata["route_origin"]``, or any
-    scene with ``route``), ``n_targets`` = 17, ``spacing`` = 0.3048, ``route`` = ``None``
-    (a sequence of at least two points ``(x, y)`` or ``(x, y, yaw)``, metres and radians
-    counter-clockwise from +x, e.g. ``[(1, 0), (2, 0.3), (3, 0)]``, or the path of a
-    ``.csv``, ``.npy`` or ``.json`` file of such rows, at most 10,000: the first is where the
-    robot starts, the others are the targets in order; a missing yaw is the direction of
-    travel from the previous point; consecutive points at least 0.05 m apart, every point
-    inside the scene with room for the robot's body, 0.16 m of clearance, and joined to
-    the next by a path for it; replaces the straight route, so
-    ``n_targets`` and ``spacing`` must then keep their defaults), ``start_jitter``,
-    ``success_radius``, ``success_on``, ``reward``, ``lighting_change`` = 0 (0-1: strength
-    of the illumination change between snapshots and run: light direction, brightness,
-    contrast), and every camera and robot argument of ``LocalHoming-v0``. A bad ``route``
-    raises ``ValueError``.
+    The task's arguments, then the env core's, as in ``LocalHoming-v0`` (the table
+    below). ``route``: a sequence of at least two points ``(x, y)`` or ``(x, y, yaw)``
+    (metres, radians counter-clockwise from +x), e.g. ``[(1, 0), (2, 0.3), (3, 0)]``, or
+    the path of a ``.csv``, ``.npy`` or ``.json`` file of such rows, at most 10,000: the
+    first is where the robot starts, the others are the targets in order; a missing yaw is
+    the direction of travel from the previous point; consecutive points at least 0.05 m
+    apart, every point inside the scene with room for the robot's body, 0.16 m of
+    clearance, and joined to the next by a path for it; it replaces the straight route,
+    so ``n_targets`` and ``spacing`` must then keep their defaults. A bad ``route`` raises
+    ``ValueError``.
 
     ## Version history
 
     * v0: initial release.
     """
 
+    ARGUMENTS: dict[str, Row] = {
+        "scene": (SCENE[0] + " with `metadata['route_origin']`, or any with `route`", "",
+                  SCENE[2]),
+        "n_targets": ("integer in [1, 9,999]", "", "targets of the straight route"),
+        "spacing": ("[0.05, 100]", "metres", "distance between the straight route's targets"),
+        "route": ("`None`, points or a file (see above)", "metres, radians",
+                  "any other route: the start, then the targets"),
+        "start_jitter": START_JITTER, "success_radius": SUCCESS_RADIUS,
+        "success_on": SUCCESS_ON, "reward": REWARD}
+
     def __init__(self, scene: str | Scene = "hallway", *, n_targets: int = 17,
                  spacing: float = FOOT,
                  route: Sequence[Sequence[float]] | str | os.PathLike | None = None,
                  start_jitter: tuple[float, float] = (0.05, 0.1745),
-                 success_radius: float = 0.1, success_on: str = "reach",
+                 success_radius: float = 0.1, success_on: str = "stop",
                  reward: RewardConfig = RewardConfig(), **kwargs):
         check_env_kwargs(type(self), kwargs)
         task = RouteFollowingTask(n_targets=n_targets, spacing=spacing, route=route,
@@ -320,10 +326,10 @@ class LongRangeHomingEnv(HomingEnv):
 
     ## Episode end
 
-    Never during the outbound phase. In the homing phase, terminated on success:
-    ``success_on="reach"`` (default) when the robot centre comes within
-    ``success_radius`` = 0.2 m of home; ``success_on="stop"`` when the agent issues stop
-    (a success if within ``success_radius``). Truncated after ``max_episode_steps`` =
+    Never during the outbound phase. In the homing phase: ``success_on="stop"`` (default;
+    why: ``LocalHoming-v0``) terminated when the agent issues stop, a success if within
+    ``success_radius`` = 0.2 m of home; ``success_on="reach"`` terminated, a success, when
+    the robot centre comes within ``success_radius``. Truncated after ``max_episode_steps`` =
     2500 steps in all (outbound steps included).
 
     ## Info
@@ -334,20 +340,26 @@ class LongRangeHomingEnv(HomingEnv):
 
     ## Arguments
 
-    ``scene`` (default ``"lab"``), ``route_length`` = 8.0 (metres, 0.5-30),
-    ``outbound_speed`` = 0.15 (m/s, at most ``max_speed``), ``outbound_yaw_rate`` = 0.5
-    (rad/s, at most ``max_yaw_rate``), ``success_radius``, ``success_on``, ``reward``,
-    ``obs_keys`` and every camera and robot argument of ``LocalHoming-v0``. A scene that
-    cannot hold the route raises ``ValueError`` at reset.
+    The task's arguments, then the env core's, as in ``LocalHoming-v0`` (the table
+    below). A scene that cannot hold the route raises ``ValueError`` at reset.
 
     ## Version history
 
     * v0: initial release.
     """
 
+    ARGUMENTS: dict[str, Row] = {
+        "scene": (SCENE[0] + " with room for the route", "", SCENE[2]),
+        "route_length": ("[0.5, 30]", "metres", "length of the outbound route"),
+        "outbound_speed": ("> 0, at most `max_speed`", "m/s", "the outbound driver's speed"),
+        "outbound_yaw_rate": ("> 0, at most `max_yaw_rate`", "rad/s",
+                              "the outbound driver's largest yaw rate"),
+        "success_radius": SUCCESS_RADIUS, "success_on": SUCCESS_ON, "reward": REWARD,
+        "obs_keys": OBS_KEYS}
+
     def __init__(self, scene: str | Scene = "lab", *, route_length: float = 8.0,
                  outbound_speed: float = 0.15, outbound_yaw_rate: float = 0.5,
-                 success_radius: float = 0.2, success_on: str = "reach",
+                 success_radius: float = 0.2, success_on: str = "stop",
                  reward: RewardConfig = RewardConfig(),
                  obs_keys: tuple[str, ...] | list[str] = ("panorama", "goal", "phase"),
                  **kwargs):
@@ -417,9 +429,9 @@ class LandmarkNavigationEnv(HomingEnv):
     *In front of* the goal: robot centre at most ``max_distance`` = 1.2 m from the panel
     centre, within ``max_angle_deg`` = 30 degrees of the panel's normal as seen from the
     panel, and the panel within 30 degrees of the robot's heading. With
-    ``success_on="reach"`` (default) the episode terminates, a success, as soon as the
-    robot is in front of the goal; with ``"stop"`` it terminates when the agent issues
-    stop, a success if it is in front of the goal then. Truncated after 3000 steps
+    ``success_on="stop"`` (default; why: ``LocalHoming-v0``) the episode terminates when
+    the agent issues stop, a success if it is in front of the goal then; with ``"reach"``
+    it terminates, a success, as soon as the robot is in front of the goal. Truncated after 3000 steps
     (300 s).
 
     ## Info
@@ -429,20 +441,30 @@ class LandmarkNavigationEnv(HomingEnv):
 
     ## Arguments
 
-    ``scene`` (default ``"corridors"``; any scene with ``metadata["landmarks"]`` and
-    ``metadata["rooms"]``), ``max_distance``, ``max_angle_deg``, ``standoff``,
-    ``success_on``, ``reward``, ``remove_landmarks`` = 0, ``occlude_landmarks`` = 0
-    (probabilities in [0, 1]), ``view_size``, ``view_hfov_deg``, ``obs_keys``, and every
-    camera and robot argument of ``LocalHoming-v0``.
+    The task's arguments, then the env core's, as in ``LocalHoming-v0`` (the table
+    below).
 
     ## Version history
 
     * v0: initial release.
     """
 
+    ARGUMENTS: dict[str, Row] = {
+        "scene": (SCENE[0] + " with `metadata['landmarks']` and `['rooms']`", "", SCENE[2]),
+        "max_distance": ("> 0", "metres", "farthest from the panel that is in front of it"),
+        "max_angle_deg": ("(0, 90]", "degrees", "widest angle off the panel's normal"),
+        "standoff": ("> 0", "metres", "the standing pose's distance in front of the panel"),
+        "success_on": SUCCESS_ON, "reward": REWARD,
+        "remove_landmarks": ("[0, 1]", "", "probability that a landmark is missing"),
+        "occlude_landmarks": ("[0, 1]", "", "probability that a landmark is partly hidden"),
+        "view_size": ("(width, height) integers in [16, 4096]", "pixels",
+                      "size of the `view` image"),
+        "view_hfov_deg": ("[5, 150]", "degrees", "horizontal field of view of `view`"),
+        "obs_keys": OBS_KEYS}
+
     def __init__(self, scene: str | Scene = "corridors", *, max_distance: float = 1.2,
                  max_angle_deg: float = 30.0, standoff: float = 0.8,
-                 success_on: str = "reach", reward: RewardConfig = RewardConfig(),
+                 success_on: str = "stop", reward: RewardConfig = RewardConfig(),
                  remove_landmarks: float = 0.0, occlude_landmarks: float = 0.0,
                  view_size: tuple[int, int] = (320, 240), view_hfov_deg: float = 60.0,
                  obs_keys: tuple[str, ...] | list[str] = ("panorama", "goal_id"), **kwargs):
@@ -561,19 +583,33 @@ class WorkLocationsEnv(HomingEnv):
 
     ## Arguments
 
-    ``scene`` (default ``"house"``; any scene with ``metadata["work_locations"]``,
-    ``["paths"]`` and ``["feature_points"]``, and for daily changes ``["small_objects"]``
-    and ``["rooms"]``), ``start_location``, ``goal_location``, ``start_jitter``,
-    ``daily_changes`` = 0 (in [0, 1]), ``teach_levels`` = 2 (1-4), ``place_spacing`` =
-    0.47 (m), ``template_size`` = 17 (odd, pixels), ``max_points`` = 10 (2-10),
-    ``success_radius``, ``success_on``, ``reward``, ``obs_keys``, ``panorama_shape`` and
-    every camera and robot argument of ``LocalHoming-v0``. Unknown location names, a
-    path with more than 32 places, or values out of range raise ``ValueError``.
+    The task's arguments, then the env core's, as in ``LocalHoming-v0`` (the table
+    below). Unknown location names, a path with more than 32 places, or values out of
+    range raise ``ValueError``.
 
     ## Version history
 
     * v0: initial release.
     """
+
+    ARGUMENTS: dict[str, Row] = {
+        "scene": (SCENE[0] + " with `metadata['work_locations']`, `['paths']`, "
+                  "`['feature_points']`", "", SCENE[2]),
+        "start_location": ("a work location's name, or `None`: any", "",
+                           "where the robot starts"),
+        "goal_location": ("a work location's name, or `None`: any", "",
+                          "where it must travel to"),
+        "start_jitter": START_JITTER,
+        "daily_changes": ("[0, 1]", "", "strength of the day's changes (0: the house as "
+                          "taught)"),
+        "teach_levels": ("integer in [1, 4]", "pyramid steps", "low resolution of the taught "
+                         "images"),
+        "place_spacing": ("[0.05, 2]", "metres", "distance between the path's taught places"),
+        "template_size": ("odd integer in [5, 63]", "pixels", "side of the templates"),
+        "max_points": ("integer in [2, 10]", "", "characteristic points per location"),
+        "success_radius": SUCCESS_RADIUS, "success_on": SUCCESS_ON, "reward": REWARD,
+        "panorama_shape": ("as `LocalHoming-v0`'s", "pixels", "panorama size (H, W)"),
+        "obs_keys": OBS_KEYS}
 
     def __init__(self, scene: str | Scene = "house", *, start_location: str | None = None,
                  goal_location: str | None = None,

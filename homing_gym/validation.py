@@ -23,21 +23,31 @@ def require_positive(name: str, value, unit: str = "") -> float:
 
 
 def require_number(name: str, value, low: float, high: float, unit: str = "", *,
-                   integer: bool = False, high_open: bool = False) -> float:
+                   integer: bool = False, high_open: bool = False,
+                   low_open: bool = False) -> float:
     """``value`` if it is a finite real number (an integer when ``integer``) in
-    ``[low, high]`` (``[low, high)`` when ``high_open``); else ``ValueError`` naming
-    ``name``, the range, the unit and the value. Returns a float, or an int when
-    ``integer``."""
+    ``[low, high]`` (without ``high`` when ``high_open``, without ``low`` when
+    ``low_open``); else ``ValueError`` naming ``name``, the range, the unit and the value.
+    Returns a float, or an int when ``integer``."""
     ok = is_real(value) and (not integer or isinstance(value, numbers.Integral)) and (
-        low <= value < high if high_open else low <= value <= high)
+        (low < value if low_open else low <= value)
+        and (value < high if high_open else value <= high))
     if not ok:
         kind = "an integer" if integer else "a number"
-        bracket = ")" if high_open else "]"
         of = f" {unit}" if unit else ""
-        shown = (lambda v: f"{int(v):,}") if integer else (lambda v: f"{v:g}")
-        raise ValueError(f"{name} must be {kind} in [{shown(low)}, {shown(high)}{bracket}{of}, "
+        raise ValueError(f"{name} must be {kind} in "
+                         f"{interval(low, high, integer, low_open, high_open)}{of}, "
                          f"got {value!r}")
     return int(value) if integer else float(value)
+
+
+def interval(low: float, high: float, integer: bool = False, low_open: bool = False,
+             high_open: bool = False) -> str:
+    """``[low, high]`` as text, a parenthesis at an open end; integers with thousands
+    separators."""
+    shown = (lambda v: f"{int(v):,}") if integer else (lambda v: f"{v:g}")
+    return (f"{'(' if low_open else '['}{shown(low)}, {shown(high)}"
+            f"{')' if high_open else ']'}")
 
 
 def require_sequence(name: str, value, length: int, what: str) -> tuple:

@@ -43,6 +43,11 @@ from homing_gym.validation import require_number
 from homing_gym.vision import horizon_line
 
 RENDERERS = ("tiny", "egl", "raycast")
+#: Allowed panorama heights and widths (pixels, inclusive) and numbers of perspective views.
+PANORAMA_HEIGHTS, PANORAMA_WIDTHS = (8, 1024), (16, 4096)
+N_VIEWS = (3, 4, 6, 8)
+PANORAMA_SHAPES = (f"(H, W) integers with {PANORAMA_HEIGHTS[0]} <= H <= {PANORAMA_HEIGHTS[1]} "
+                   f"and {PANORAMA_WIDTHS[0]} <= W <= {PANORAMA_WIDTHS[1]}")
 OMNI_INNER, OMNI_OUTER = 0.25, 0.98
 
 
@@ -91,15 +96,15 @@ class CameraConfig:
     def __post_init__(self) -> None:
         shape = self.panorama_shape
         if (len(shape) != 2 or not all(isinstance(v, (int, np.integer)) for v in shape)
-                or not (8 <= shape[0] <= 1024 and 16 <= shape[1] <= 4096)):
-            raise ValueError(f"panorama_shape must be (H, W) integers with 8 <= H <= 1024 and "
-                             f"16 <= W <= 4096, got {shape!r}")
+                or not (PANORAMA_HEIGHTS[0] <= shape[0] <= PANORAMA_HEIGHTS[1]
+                        and PANORAMA_WIDTHS[0] <= shape[1] <= PANORAMA_WIDTHS[1])):
+            raise ValueError(f"panorama_shape must be {PANORAMA_SHAPES}, got {shape!r}")
         if not (math.radians(10) <= self.vfov <= math.radians(120)):
             raise ValueError(f"vfov must lie in [10, 120] degrees (given in radians), got "
                              f"{self.vfov!r} rad = {math.degrees(self.vfov):.1f} deg")
         if not isinstance(self.n_views, (int, np.integer)) or isinstance(self.n_views, bool) \
-                or self.n_views not in (3, 4, 6, 8):
-            raise ValueError(f"n_views must be one of (3, 4, 6, 8), got {self.n_views!r}")
+                or self.n_views not in N_VIEWS:
+            raise ValueError(f"n_views must be one of {N_VIEWS}, got {self.n_views!r}")
         require_number("omni_size", self.omni_size, 16, 2048, "pixels", integer=True)
         if not (1 <= self.signature_rows <= shape[0] - 2):
             raise ValueError(f"signature_rows must be in [1, H - 2] = [1, {shape[0] - 2}], "

@@ -70,16 +70,17 @@ class RewardConfig:
 class GoalReachingTask(Task):
     """Visit the episode's goals in order (``Episode.goals``: waypoints, then home).
 
+    ``success_on="stop"`` (default): the agent itself signals arrival with the stop action;
+    the goal is then left with the distance at the stop as its error (the accuracy
+    protocol of the papers, where the method decides it has arrived).
     ``success_on="reach"``: a goal is reached as soon as the robot centre is within
-    ``success_radius`` metres of it. ``success_on="stop"``: the agent itself signals arrival
-    with the stop action; the goal is then left with the distance at the stop as its error
-    (the accuracy protocol of the papers, where the method decides it has arrived). After
+    ``success_radius`` metres of it. After
     the last goal the episode terminates; it is a success if that goal was within
     ``success_radius``. ``goal_errors`` holds the distance (metres) at which each goal was
     left.
     """
 
-    def __init__(self, success_radius: float = 0.15, success_on: str = "reach",
+    def __init__(self, success_radius: float = 0.15, success_on: str = "stop",
                  reward: RewardConfig | Mapping[str, float] = RewardConfig()):
         self.success_radius = checked_success_radius(success_radius)
         if success_on not in SUCCESS_MODES:

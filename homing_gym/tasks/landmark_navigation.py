@@ -49,13 +49,13 @@ def standing_pose(panel: tuple[float, float, float], standoff: float) -> np.ndar
 
 
 class LandmarkNavigationTask(Task):
-    """See the module docstring. ``success_on="reach"`` ends the episode as soon as the
-    robot is in front of the goal; ``"stop"`` when the agent stops (a success if it is in
-    front of the goal then). ``view_size``/``view_hfov_deg``: the optional ``view``
+    """See the module docstring. ``success_on="stop"`` (default) ends the episode when the
+    agent stops (a success if it is in front of the goal then); ``"reach"`` as soon as the
+    robot is in front of the goal. ``view_size``/``view_hfov_deg``: the optional ``view``
     observation, the forward perspective camera (pixels, degrees)."""
 
     def __init__(self, max_distance: float = 1.2, max_angle_deg: float = 30.0,
-                 standoff: float = 0.8, success_on: str = "reach",
+                 standoff: float = 0.8, success_on: str = "stop",
                  reward: RewardConfig = RewardConfig(), clearance_margin: float = 0.25,
                  view_size: tuple[int, int] = (320, 240), view_hfov_deg: float = 60.0):
         require_positive("max_distance", max_distance, "metres")

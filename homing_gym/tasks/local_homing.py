@@ -20,7 +20,7 @@ class LocalHomingTask(GoalReachingTask):
     :class:`GoalReachingTask` for ``success_radius`` and ``success_on``)."""
 
     def __init__(self, start_distance: tuple[float, float] = (0.3, 1.5),
-                 success_radius: float = 0.15, success_on: str = "reach",
+                 success_radius: float = 0.15, success_on: str = "stop",
                  reward: RewardConfig = RewardConfig(), clearance_margin: float = 0.22):
         super().__init__(success_radius, success_on, reward)
         self.set_start_distance(start_distance)

@@ -82,7 +82,7 @@ class LongRangeHomingTask(GoalReachingTask):
 
     def __init__(self, route_length: float = 8.0, outbound_speed: float = 0.15,
                  outbound_yaw_rate: float = 0.5, success_radius: float = 0.2,
-                 success_on: str = "reach", reward: RewardConfig = RewardConfig(),
+                 success_on: str = "stop", reward: RewardConfig = RewardConfig(),
                  clearance_margin: float = 0.3):
         if not (is_real(route_length) and 0.5 <= route_length <= 30):
             raise ValueError(f"route_length must be in [0.5, 30] metres, got {route_length!r}")

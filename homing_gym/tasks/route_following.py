@@ -88,7 +88,7 @@ class RouteFollowingTask(GoalReachingTask):
 
     def __init__(self, n_targets: int = N_TARGETS, spacing: float = SPACING,
                  start_jitter: tuple[float, float] = (0.05, math.radians(10)),
-                 success_radius: float = 0.1, success_on: str = "reach",
+                 success_radius: float = 0.1, success_on: str = "stop",
                  reward: RewardConfig = RewardConfig(), clearance_margin: float = 0.18,
                  route: Sequence[Sequence[float]] | str | os.PathLike | None = None):
         route = load_route(route)                       # a path: the points of its file

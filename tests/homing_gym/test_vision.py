@@ -56,7 +56,8 @@ def test_discrete_actions():
 
 
 def test_turn_left_turns_counter_clockwise():
-    env = gym.make("homing_gym/LocalHoming-v0", action_type="discrete", panorama_shape=(16, 64))
+    env = gym.make("homing_gym/LocalHoming-v0", action_type="discrete", panorama_shape=(16, 64),
+                   success_on="reach")
     _, info = env.reset(seed=0, options={"start": [0.0, 0.0, 0.0]})
     for _ in range(5):
         _, _, _, _, info = env.step(DiscreteAction.TURN_LEFT)
