@@ -11,14 +11,12 @@ path); the scene of each shown episode is rebuilt with ``env.reset(seed)``.
 
 from __future__ import annotations
 
-import inspect
 import os
 import sys
 from typing import Sequence
 
 import cv2
 import gymnasium as gym
-from gymnasium.envs.registration import load_env_creator
 import matplotlib
 
 matplotlib.use("Agg")
@@ -27,7 +25,8 @@ import numpy as np  # noqa: E402
 
 from homing_gym.cli import command_parser  # noqa: E402
 from homing_gym.render.topdown import MapCanvas, draw_pose, draw_scale_bar, draw_scene  # noqa: E402
-from homing_train.harness.evaluate import EvalResult  # noqa: E402
+from homing_train.harness.evaluate import (EvalResult, env_default,  # noqa: E402
+                                           success_rule_text)
 from homing_train.harness.matrix import episode_seconds  # noqa: E402
 from homing_train.harness.palette import (HOME_MARK, START_MARK, method_color,  # noqa: E402
                                           method_color_255)
@@ -93,10 +92,17 @@ NEUTRAL_KEYS = ("obs_keys",)
 def success_rule(result: EvalResult) -> tuple:
     """``(env id, success_on, success_radius)`` a result was scored under: its env kwargs,
     else the env's defaults (``None`` where the env has no such argument)."""
-    params = inspect.signature(load_env_creator(gym.spec(result.env_id).entry_point)).parameters
-    return (result.env_id, *(result.env_kwargs.get(
-        key, params[key].default if key in params else None)
-        for key in ("success_on", "success_radius")))
+    return (result.env_id, *(result.env_kwargs.get(key, env_default(result.env_id, key))
+                             for key in ("success_on", "success_radius")))
+
+
+def rule_line(result: EvalResult) -> str:
+    """The line of ``table.md`` that states the success rule of every row (one rule:
+    :func:`check_one_rule`)."""
+    env, on, radius = success_rule(result)
+    within = f" within {radius:g} m" if radius is not None else ""
+    return (f"Success rule: {env.split('/')[-1]}, success_on={on!r} ("
+            f"{success_rule_text(on)}{within}).\n")
 
 
 def check_one_rule(results: Sequence[EvalResult]) -> None:
@@ -269,7 +275,7 @@ def compare(paths: Sequence[str], out: str, trajectories: int = 3) -> dict[str, 
                "final_distance": os.path.join(out, "final_distance.png")}
     routes = route_table(results)
     notes = settings_notes(results) + ([unpaired] if unpaired else [])
-    write_text_atomic(written["table"], markdown_table(results)
+    write_text_atomic(written["table"], rule_line(results[0]) + "\n" + markdown_table(results)
                       + ("\n" + routes if routes else "")
                       + ("\n" + "".join(f"Note: {n}.\n" for n in notes) if notes else ""))
     plot_success_vs_distance(results, written["success_vs_distance"])

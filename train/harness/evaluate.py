@@ -166,9 +166,16 @@ class EvalResult:
         tasks' default 0.15."""
         return float(self.env_kwargs.get("success_radius", 0.15))
 
+    @property
+    def success_on(self) -> str | None:
+        """The success rule the episodes were scored under (``"stop"`` or ``"reach"``, as
+        recorded in the env kwargs; ``None`` for a result that did not record it)."""
+        return self.env_kwargs.get("success_on")
+
     def to_dict(self) -> dict[str, Any]:
         return {"schema": SCHEMA, "policy": self.policy, "params": self.params,
-                "env_id": self.env_id, "env_kwargs": self.env_kwargs, "seed": self.seed,
+                "env_id": self.env_id, "success_on": self.success_on,
+                "env_kwargs": self.env_kwargs, "seed": self.seed,
                 "homing_gym_version": homing_gym.__version__, "summary": self.summary,
                 "episodes": [asdict(e) for e in self.episodes]}
 
@@ -176,7 +183,7 @@ class EvalResult:
         """Write the JSON document to ``path`` and the episode table to ``path`` .csv,
         each atomically (an interrupted save leaves the old file or the new one)."""
         write_text_atomic(path, json.dumps(self.to_dict(), default=_json_default))
-        write_csv(self.episodes, os.path.splitext(path)[0] + ".csv")
+        write_csv(self.episodes, os.path.splitext(path)[0] + ".csv", self.success_on)
 
     @classmethod
     def load(cls, path: str) -> "EvalResult":
@@ -226,16 +233,17 @@ def _json_default(obj: Any) -> Any:
     return repr(obj)
 
 
-def write_csv(episodes: Sequence[EpisodeRecord], path: str) -> None:
-    """One row per episode, every field but the trajectory."""
+def write_csv(episodes: Sequence[EpisodeRecord], path: str, success_on: str | None) -> None:
+    """One row per episode, every field but the trajectory, and the success rule
+    ``success_on`` the episodes were scored under (empty when unrecorded)."""
     names = [f.name for f in dataclasses.fields(EpisodeRecord) if f.name != "trajectory"]
     with atomic_path(path) as tmp, open(tmp, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=names)
+        writer = csv.DictWriter(f, fieldnames=[*names, "success_on"])
         writer.writeheader()
         for e in episodes:
             row = asdict(e)
-            writer.writerow({k: (json.dumps(row[k]) if isinstance(row[k], list) else row[k])
-                             for k in names})
+            writer.writerow({**{k: (json.dumps(row[k]) if isinstance(row[k], list) else row[k])
+                                for k in names}, "success_on": success_on or ""})
 
 
 def summarize(episodes: Sequence[EpisodeRecord], bin_width: float = 0.3,
@@ -580,6 +588,23 @@ def env_parameters(env_id: str) -> frozenset[str] | None:
                                    inspect.Parameter.KEYWORD_ONLY))
 
 
+def env_default(env_id: str, name: str) -> Any:
+    """The default of the argument ``name`` of the env of ``env_id``, or ``None`` when its
+    entry point names no such argument with a default."""
+    try:
+        param = inspect.signature(_env_creator(env_id)).parameters.get(name)
+    except (TypeError, ValueError):             # a builtin or C callable: cannot tell
+        return None
+    return None if param is None or param.default is inspect.Parameter.empty else param.default
+
+
+def success_rule_setting(env_id: str, env_kwargs: dict[str, Any]) -> dict[str, Any]:
+    """``{"success_on": rule}``: the given rule, else the default of the env of
+    ``env_id``, for a result to record explicitly; ``{}`` when the env names none."""
+    rule = env_kwargs.get("success_on", env_default(env_id, "success_on"))
+    return {} if rule is None else {"success_on": rule}
+
+
 def harness_env_kwargs(env_id: str, env_kwargs: dict[str, Any],
                        added: dict[str, Any]) -> dict[str, Any]:
     """``env_kwargs`` with the harness's ``added`` defaults (e.g. the renderer, recorded
@@ -633,7 +658,8 @@ def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int =
         recorded = recorded_settings(spec.source)
         env_kwargs = {**recorded.env_kwargs, **env_kwargs}
         spec = dataclasses.replace(spec, params={**recorded.params, **spec.params})
-    added = simulation_settings(env_kwargs)                 # recorded explicitly
+    # recorded explicitly: the simulation and the success rule
+    added = {**simulation_settings(env_kwargs), **success_rule_setting(env_id, env_kwargs)}
     if spec.kind == "controller":
         # what the controller reads; observation keys never change the episodes
         added["obs_keys"] = list(spec.build().observation_keys())
@@ -804,12 +830,19 @@ def format_summary(result: EvalResult) -> str:
     s = result.summary
     lo, hi = s["success_ci"]
     return (f"{result.policy} on {result.env_id}: {s['episodes']} episodes, success "
+            f"({success_rule_text(result.success_on)}) "
             f"{100 * s['success_rate']:.1f}% [{100 * lo:.1f}, {100 * hi:.1f}], SPL "
             f"{s['spl']:.3f}, soft-SPL {s['soft_spl']:.3f}, final distance "
             f"{100 * s['final_distance_mean']:.1f} cm (median "
             f"{s['final_distance_cm_median']:.1f}), heading error "
             f"{s['heading_error_deg_mean']:.1f} deg, collisions/episode "
             f"{s['collisions_mean']:.2f}{_route_line(s)}")
+
+
+def success_rule_text(success_on: str | None) -> str:
+    """How results scored under ``success_on`` count a success, in a few words."""
+    return {"stop": "stopped at the goal", "reach": "reached the goal"}.get(
+        success_on, f"rule {success_on!r}" if success_on else "rule not recorded")
 
 
 def _route_line(s: dict[str, Any]) -> str:

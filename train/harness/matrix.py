@@ -67,7 +67,8 @@ class Cell:
     episode counts, and the command that reproduces it; ``privileged``: what beyond
     pixels the protocol gives and the policy trained on (its shipped ``.yml``);
     ``seed``: the base seed its episodes were drawn from, ``canonical_draw``: whether
-    that is the protocol's own (``homing-eval --protocol P --seed S`` draws others)."""
+    that is the protocol's own (``homing-eval --protocol P --seed S`` draws others);
+    ``success_on``: the success rule its episodes were scored under."""
 
     protocol: str
     version: int
@@ -78,6 +79,7 @@ class Cell:
     privileged: str = ""
     seed: int | None = None
     canonical_draw: bool = True
+    success_on: str = "stop"
 
 
 def shipped_for(env_ids: Sequence[str]) -> dict:
@@ -231,7 +233,8 @@ def run_cell(protocol: Protocol, method: str, out: Path, episodes: int | None = 
                 command=protocol.command(method, episodes),
                 summary=summarize(records, radius=radius), settings=per_setting,
                 privileged="; ".join(p for p in (protocol.privileged, own) if p),
-                seed=protocol.seed, canonical_draw=protocol.canonical)
+                seed=protocol.seed, canonical_draw=protocol.canonical,
+                success_on=protocol.settings[0].kwargs()["success_on"])
     write_text_atomic(str(out / "cell.json"), json.dumps(asdict(cell), indent=1))
     return cell
 

@@ -135,7 +135,11 @@ def test_eval_cli_writes_json_and_csv(tmp_path, capsys):
     assert doc["schema"] == 1 and doc["policy"] == "random" and doc["seed"] == 4
     assert doc["params"]["step_length"] == 0.15
     assert doc["env_kwargs"] == {**SHORT, "obs_keys": ["panorama", "goal"],     # recorded as used
-                                 "renderer": "raycast", "physics_substeps": 12}
+                                 "renderer": "raycast", "physics_substeps": 12,
+                                 "success_on": "stop"}
+    assert doc["success_on"] == "stop"                  # the rule, stated at the top too
+    assert "random on homing_gym/LocalHoming-v0: 2 episodes, success (stopped at the goal) " \
+        in capsys.readouterr().out
     for key in ("episodes", "success_rate", "success_ci", "spl", "soft_spl",
                 "final_distance_mean", "path_length_mean", "steps_mean", "success_by_distance"):
         assert key in doc["summary"]
@@ -143,6 +147,7 @@ def test_eval_cli_writes_json_and_csv(tmp_path, capsys):
     assert all(e["steps"] == 8 and len(e["trajectory"]) == 9 for e in doc["episodes"])
     rows = list(csv.DictReader(open(tmp_path / "r.csv")))
     assert [r["seed"] for r in rows] == ["4", "5"] and "trajectory" not in rows[0]
+    assert [r["success_on"] for r in rows] == ["stop", "stop"]
     assert EvalResult.load(str(out)).summary == doc["summary"]
 
 
@@ -226,8 +231,10 @@ def test_compare_writes_table_and_pngs(tmp_path):
         r.save(paths[-1])
     assert compare_cli.main(paths + ["--out", str(tmp_path / "cmp"), "--trajectories", "2"]) == 0
     table = (tmp_path / "cmp" / "table.md").read_text().splitlines()
-    assert table[2].startswith("| oracle |") and table[3].startswith("| random |")
-    for line, path in zip(table[2:4], paths):    # each cell is its result's own value
+    assert table[0] == ("Success rule: LocalHoming-v0, success_on='stop' (stopped at the goal "
+                        "within 0.15 m).")
+    assert table[4].startswith("| oracle |") and table[5].startswith("| random |")
+    for line, path in zip(table[4:6], paths):    # each cell is its result's own value
         s = EvalResult.load(path).summary
         cells = [c.strip() for c in line.strip("|").split("|")]
         assert cells[1] == str(s["episodes"])
@@ -241,20 +248,20 @@ def test_compare_writes_table_and_pngs(tmp_path):
 
 def test_compare_refuses_rows_scored_under_different_rules_and_notes_unpaired_seeds(tmp_path):
     from homing_train.harness.compare import compare
-    runs = {"stop": ({"success_on": "stop"}, 0), "reach": ({}, 0),          # reach: the default
-            "wide": ({"success_radius": 0.3}, 0), "later": ({}, 5)}
+    runs = {"stop": ({}, 0), "reach": ({"success_on": "reach"}, 0),        # stop: the default
+            "wide": ({"success_radius": 0.3}, 0), "later": ({"success_on": "stop"}, 5)}
     paths = {}
     for name, (kwargs, seed) in runs.items():
         r = evaluate("oracle", ENV_ID, episodes=2, seed=seed, progress=False,
                      env_kwargs={"max_episode_steps": 40, **kwargs})
         paths[name] = str(tmp_path / f"{name}.json")
         r.save(paths[name])
-    for other in ("stop", "wide"):
+    for other in ("reach", "wide"):
         with pytest.raises(ValueError, match="different success rules") as err:
-            compare([paths["reach"], paths[other]], str(tmp_path / "cmp"))
-        assert "success_on='reach', success_radius=0.15" in str(err.value)
+            compare([paths["stop"], paths[other]], str(tmp_path / "cmp"))
+        assert "success_on='stop', success_radius=0.15" in str(err.value)
     assert not (tmp_path / "cmp").exists()
-    compare([paths["reach"], paths["later"]], str(tmp_path / "cmp"))   # default == explicit
+    compare([paths["stop"], paths["later"]], str(tmp_path / "cmp"))    # default == explicit
     assert ("the results cover different episode seeds, 0 shared"
             in (tmp_path / "cmp" / "table.md").read_text())
 
@@ -280,8 +287,8 @@ def test_sb3_model_zip_is_evaluated(tmp_path):
     path = tmp_path / "ppo_tiny.zip"
     model.save(path)
     env.close()
-    result = evaluate(str(path), ENV_ID, episodes=1, seed=0, env_kwargs={"max_episode_steps": 3},
-                      progress=False)
+    result = evaluate(str(path), ENV_ID, episodes=1, seed=0, progress=False,   # to the limit:
+                      env_kwargs={"max_episode_steps": 3, "success_on": "reach"})  # no stop
     assert result.policy == "ppo_tiny" and result.episodes[0].steps == 3
     with pytest.raises(ValueError, match="observation_space"):
         evaluate(str(path), ENV_ID, episodes=1, env_kwargs={"obs_keys": ["signature"]},

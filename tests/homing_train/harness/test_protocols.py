@@ -1,6 +1,7 @@
 """Protocols and the methods x protocols matrix: episodes as the papers draw them, one
 success rule, cells that reproduce from their command."""
 
+import csv
 import json
 import math
 
@@ -210,6 +211,8 @@ def test_matrix_files_name_every_cell_with_its_command(tmp_path):
     assert "| cloned (privileged: oracle demonstrations) | 30 [10, 60] |" in text
     assert "`homing-eval --protocol yukim --policy distance --out OUT.json`" in text
     assert open(written["csv"]).read().count("\n") == 4
+    assert all(row["success_on"] == "stop" for row in csv.DictReader(open(written["csv"])))
+    assert all(cell["success_on"] == "stop" for cell in json.load(open(written["json"])))
     assert open(written["png"], "rb").read(4) == b"\x89PNG"
 
 
