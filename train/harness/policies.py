@@ -169,7 +169,8 @@ def recorded_settings(zip_path: str) -> RecordedSettings:
 def policy_spec(policy: str | Controller | PolicySpec,
                 params: dict[str, Any] | None = None) -> PolicySpec:
     """Interpret ``policy``: a :class:`PolicySpec`, a controller instance, a registered
-    controller name or the path of a stable-baselines3 ``.zip``."""
+    controller name, a shipped policy's name (``ppo``: :data:`DEFAULT_POLICY`) or the
+    path of a stable-baselines3 ``.zip``."""
     params = dict(params or {})
     if isinstance(policy, PolicySpec):
         return policy
@@ -183,6 +184,7 @@ def policy_spec(policy: str | Controller | PolicySpec,
     if policy in homing_baselines.available():
         homing_baselines.make(policy, **params)  # validates the parameters now
         return PolicySpec("controller", policy, params)
+    policy = shipped_policy_path(policy) or policy
     if policy.endswith(".zip") or os.path.exists(policy):
         if not os.path.isfile(policy):
             raise ValueError(f"model file {policy!r} does not exist")
@@ -195,7 +197,9 @@ def policy_spec(policy: str | Controller | PolicySpec,
                 raise ValueError(f"{key} must be true or false, got {params[key]!r}")
         return PolicySpec("sb3", policy, params)
     raise ValueError(f"unknown policy {policy!r}: not a registered controller "
-                     f"{homing_baselines.available()} nor a stable-baselines3 model .zip file")
+                     f"{homing_baselines.available()}, a shipped policy "
+                     f"{['ppo', *shipped_policy_names()]} nor a stable-baselines3 model .zip "
+                     f"file")
 
 
 def _coerce(text: str, default: Any, key: str) -> Any:
@@ -303,6 +307,20 @@ class SB3Policy:
 
 
 POLICY_DIR = Path(str(resources.files("homing_train") / "shipped"))
+#: The default learned policy, which ``--policy ppo`` names.
+DEFAULT_POLICY = "ppo_procedural_long"
+
+
+def shipped_policy_names() -> list[str]:
+    """The names of the shipped policies (their zips in :data:`POLICY_DIR`)."""
+    return sorted(p.stem for p in POLICY_DIR.glob("*.zip"))
+
+
+def shipped_policy_path(name: str) -> str | None:
+    """The zip of the shipped policy ``name`` (``"ppo"``: :data:`DEFAULT_POLICY`), or
+    ``None`` when no shipped policy has that name."""
+    name = DEFAULT_POLICY if name == "ppo" else name
+    return str(POLICY_DIR / f"{name}.zip") if name in shipped_policy_names() else None
 
 
 @dataclass(frozen=True)

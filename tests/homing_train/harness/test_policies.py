@@ -2,7 +2,10 @@
 
 import yaml
 
-from homing_train.harness.policies import recorded_settings
+import pytest
+
+from homing_train.harness.policies import (DEFAULT_POLICY, POLICY_DIR, policy_spec,
+                                           recorded_settings)
 
 
 def test_a_run_folders_models_and_checkpoints_take_the_runs_training_settings(tmp_path):
@@ -21,3 +24,12 @@ def test_a_run_folders_models_and_checkpoints_take_the_runs_training_settings(tm
     (run / "config.yml").write_text(yaml.safe_dump({**config, "eval_deterministic": False}))
     assert recorded_settings(str(run / "best_model.zip")).params == {"deterministic": False}
     assert recorded_settings(str(tmp_path / "elsewhere.zip")).env_kwargs == {}
+
+
+def test_ppo_and_shipped_names_are_policies():
+    assert policy_spec("ppo").source == str(POLICY_DIR / f"{DEFAULT_POLICY}.zip")
+    assert policy_spec("ppo_procedural_imitation").kind == "sb3"
+    assert policy_spec("ppo", {"deterministic": False}).params == {"deterministic": False}
+    with pytest.raises(ValueError, match=r"unknown policy 'ppo_localhoming'.*a shipped policy "
+                       r"\['ppo', 'ppo_procedural_imitation', 'ppo_procedural_long'\]"):
+        policy_spec("ppo_localhoming")
