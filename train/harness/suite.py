@@ -225,11 +225,11 @@ def _headline(args) -> int:
     cells = run_matrix(plan.protocols, Path(args.out), plan.episodes, args.workers,
                        plan.methods, resume=args.resume, backend=args.backend,
                        address=args.ray_address, by_cell=True)
-    print(headline_table(cells))
-    print(reading(cells))
     print(f"wrote {args.out}/matrix.md (every cell's command, the papers' claims), "
           f"matrix.csv, matrix.json, matrix.png, and each cell's files under "
-          f"{args.out}/<protocol>/<method>/")
+          f"{args.out}/<protocol>/<method>/\n")
+    print(headline_table(cells))
+    print(reading(cells), end="")
     return 0
 
 

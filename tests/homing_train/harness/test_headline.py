@@ -112,7 +112,16 @@ def test_overlapping_intervals_claim_no_ranking():
              cell("p", "distance", 0, 4)]
     text = protocol_reading(cells)
     assert text.startswith("p: warping 75% [") and "no ranking can be claimed" in text
-    assert "snapshot 50%" in text and "distance 0%" in text      # [0, 49] overlaps [30, 95]
+    assert "overlaps snapshot 50% [15, 85] and distance 0% [0, 49]" in text  # [30, 95]
+    assert "ahead of" not in text
+
+
+def test_a_leader_tied_with_some_is_ahead_of_the_others():
+    cells = [cell("p", "ppo", 12, 12), cell("p", "distance", 8, 12),
+             cell("p", "warping", 0, 12)]
+    text = protocol_reading(cells)
+    assert "overlaps distance 67%" in text
+    assert text.endswith("ahead of warping 0% [0, 24] (intervals apart).")
 
 
 def test_the_learned_policy_is_set_against_the_best_classical_one_on_held_out_worlds():
