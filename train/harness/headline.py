@@ -1,7 +1,8 @@
 """The headline comparison: what ``homing-suite`` runs with no arguments.
 
 The held-out worlds (``unseen``, ``local-common``) and the papers' protocols, every
-classical method where it applies and the default learned policy (:data:`LEARNED`), at a
+classical method where it applies and the default learned policy
+(:data:`~homing_train.harness.policies.DEFAULT_POLICY`, ``--policy ppo``), at a
 small episode count per protocol (:data:`HEADLINE_EPISODES`, chosen to take about 4
 minutes on 2 cores with 2 workers). :func:`headline_table` is the compact methods x
 protocols table it prints, :func:`reading` the plain-language reading of the numbers
@@ -15,12 +16,9 @@ from typing import Mapping, Sequence
 
 import homing_baselines
 from homing_train.harness.matrix import Cell, cell_methods, shipped_for
-from homing_train.harness.policies import shipped_policies
+from homing_train.harness.policies import DEFAULT_POLICY, shipped_policies
 from homing_train.harness.protocols import PROTOCOLS, Protocol
 
-#: The default learned policy (the shipped one that ``--policy ppo`` names): the headline's
-#: one learned row.
-LEARNED = "ppo_procedural_long"
 #: Episodes per setting of each headline protocol, in the order of the table: the
 #: held-out worlds first, then the papers' protocols. ``yukim`` draws at least one
 #: episode per start-distance bin (4), ``bekris-lab`` one per goal (6). Chosen by the
@@ -61,13 +59,13 @@ class HeadlinePlan:
 
 
 def default_methods(protocols: Sequence[Protocol]) -> list[str]:
-    """Every classical method of ``protocols`` (in their order) and :data:`LEARNED` where a
-    protocol runs it; no other learned policy."""
+    """Every classical method of ``protocols`` (in their order) and the default learned
+    policy (``DEFAULT_POLICY``) where a protocol runs it; no other learned policy."""
     names: list[str] = []
     for p in protocols:
         names += [m for m in cell_methods(p) if m in homing_baselines.available()]
-    if any(LEARNED in shipped_for({s.env_id for s in p.settings}) for p in protocols):
-        names.append(LEARNED)
+    if any(DEFAULT_POLICY in shipped_for({s.env_id for s in p.settings}) for p in protocols):
+        names.append(DEFAULT_POLICY)
     return list(dict.fromkeys(names))
 
 
@@ -75,7 +73,8 @@ def headline_plan(episodes: int | None = None, methods: Sequence[str] | None = N
                   seed: int | None = None) -> HeadlinePlan:
     """The headline's protocols (:data:`HEADLINE_EPISODES`; ``seed``: another draw of
     their episodes), ``episodes`` per setting for all of them instead of the headline's
-    counts, and ``methods`` instead of :func:`default_methods`."""
+    counts, and ``methods`` instead of :func:`default_methods` (``ppo``: the default
+    learned policy)."""
     if episodes is not None and episodes < 1:
         raise ValueError(f"episodes must be >= 1, got {episodes}")
     protocols = tuple(PROTOCOLS[name] if seed is None else PROTOCOLS[name].reseeded(seed)
@@ -84,7 +83,8 @@ def headline_plan(episodes: int | None = None, methods: Sequence[str] | None = N
               for p in protocols}
     cell_episodes = {p.name: sum(len(s.episode_tasks(counts[p.name], p.seed))
                                  for s in p.settings) for p in protocols}
-    return HeadlinePlan(protocols, counts, tuple(methods or default_methods(protocols)),
+    chosen = [DEFAULT_POLICY if m == "ppo" else m for m in methods or []]
+    return HeadlinePlan(protocols, counts, tuple(chosen or default_methods(protocols)),
                         cell_episodes)
 
 

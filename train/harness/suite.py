@@ -52,11 +52,11 @@ from homing_train.harness.compare import compare
 from homing_train.harness.evaluate import (DEFAULT_ENV, add_backend_arguments,
                                            check_backend_arguments, check_env_id,
                                            evaluate, format_summary, stream_path)
-from homing_train.harness.headline import (LEARNED, check_methods, headline_plan,
-                                           headline_table, reading)
+from homing_train.harness.headline import (check_methods, headline_plan, headline_table,
+                                           reading)
 from homing_train.harness.matrix import (BASE_PERIOD, applicable, equal_time_kwargs,
                                          matrix_markdown, run_matrix)
-from homing_train.harness.policies import shipped_policies
+from homing_train.harness.policies import DEFAULT_POLICY, shipped_policies
 from homing_train.harness.protocols import PROTOCOLS, protocol
 from homing_train.outputs import OutputLock, output_dir_argument
 from homing_train.pool import WorkerDiedError, end_stopped_command
@@ -157,16 +157,16 @@ def main(argv: list[str] | None = None) -> int:
                         "headline's few, each protocol's own with --protocols); with "
                         "--arena per method (default 20)")
     parser.add_argument("--seed", type=seed_value, default=None,
-                        help="seed of the first episode (default 0); with --protocols the "
-                        "base seed of every protocol's episode draw instead of its own (not "
-                        "the canonical draw: each cell's command then carries --seed)")
+                        help="the base seed of every protocol's episode draw instead of its "
+                        "own (not the canonical draw: each cell's command then carries "
+                        "--seed); with --arena the seed of the first episode (default 0)")
     parser.add_argument("--workers", type=worker_count, default=DEFAULT_WORKERS,
                         help=f"parallel processes (default {DEFAULT_WORKERS}: 2, or 1 on a "
                         "one-core machine)")
     parser.add_argument("--methods", nargs="+",
                         help="subset of methods (default: every classical method where it "
-                        f"applies and the default learned policy, {LEARNED}; with --arena or "
-                        "--protocols every shipped policy too)")
+                        f"applies and the default learned policy, ppo = {DEFAULT_POLICY}; "
+                        "with --arena or --protocols every shipped policy too)")
     parser.add_argument("--success-on", choices=("stop", "reach"), default=None,
                         help="the success rule of every row of the one-env comparison "
                         "(default stop): stopped at the goal, or came within its radius at "
@@ -176,8 +176,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--resume", action="store_true",
                         help="keep the episodes already streamed into --out (an interrupted "
                         "run, or one to which methods or protocols were added) and run only "
-                        "the others; with --protocols the cells of --out's matrix.json that "
-                        "this run does not cover stay in it")
+                        "the others; the cells of --out's matrix.json that this run does not "
+                        "cover stay in it")
     add_backend_arguments(parser)
     args = parser.parse_args(argv)
     check_backend_arguments(parser, args)

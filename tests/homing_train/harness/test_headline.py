@@ -7,12 +7,11 @@ import pytest
 
 import homing_baselines
 from homing_train.harness import suite
-from homing_train.harness.headline import (HEADLINE_EPISODES, LEARNED, headline_plan,
-                                           headline_table, learned_reading, protocol_reading,
-                                           reading)
+from homing_train.harness.headline import (HEADLINE_EPISODES, headline_plan, headline_table,
+                                           learned_reading, protocol_reading, reading)
 from homing_train.harness.matrix import Cell, cell_methods
 from homing_train.harness.metrics import wilson_interval
-from homing_train.harness.policies import shipped_policies
+from homing_train.harness.policies import DEFAULT_POLICY, shipped_policies
 
 
 def cell(protocol: str, method: str, k: int, n: int) -> Cell:
@@ -32,8 +31,8 @@ def test_the_headline_plan_is_the_held_out_worlds_and_the_papers_protocols():
     assert classical == {"oracle", "random", "snapshot", "warping", "distance", "bearing",
                          "bearing-basic", "bearing-complementary", "selfsimilar", "multires"}
     learned = [m for m in plan.methods if m not in homing_baselines.available()]
-    assert set(plan.methods) == classical | {LEARNED} and learned == [LEARNED]
-    assert LEARNED in shipped_policies()
+    assert set(plan.methods) == classical | {DEFAULT_POLICY} and learned == [DEFAULT_POLICY]
+    assert DEFAULT_POLICY in shipped_policies()
     assert plan.episodes == HEADLINE_EPISODES
     # every setting's tasks: 6 worlds in unseen and local-common, yukim and bekris-lab
     # draw at least one episode per distance bin (4) and per goal (6)
@@ -47,8 +46,8 @@ def test_the_headline_plan_is_the_held_out_worlds_and_the_papers_protocols():
 
 
 def test_episodes_and_methods_replace_the_headlines():
-    plan = headline_plan(episodes=3, methods=["warping"])
-    assert set(plan.episodes.values()) == {3} and plan.methods == ("warping",)
+    plan = headline_plan(episodes=3, methods=["warping", "ppo"])
+    assert set(plan.episodes.values()) == {3} and plan.methods == ("warping", DEFAULT_POLICY)
     with pytest.raises(ValueError, match="episodes must be >= 1, got 0"):
         headline_plan(episodes=0)
 
@@ -125,21 +124,43 @@ def test_a_leader_tied_with_some_is_ahead_of_the_others():
 
 
 def test_the_learned_policy_is_set_against_the_best_classical_one_on_held_out_worlds():
-    ahead = [cell("unseen", LEARNED, 19, 20), cell("unseen", "warping", 4, 20),
+    ahead = [cell("unseen", DEFAULT_POLICY, 19, 20), cell("unseen", "warping", 4, 20),
              cell("unseen", "snapshot", 1, 20), cell("unseen", "oracle", 20, 20)]
     assert "ahead, the intervals apart" in learned_reading(ahead)
     assert "best classical method, warping 20%" in learned_reading(ahead)
-    close = [cell("unseen", LEARNED, 3, 4), cell("unseen", "warping", 2, 4)]
+    close = [cell("unseen", DEFAULT_POLICY, 3, 4), cell("unseen", "warping", 2, 4)]
     assert "no difference can be claimed" in learned_reading(close)
-    assert learned_reading([cell("yukim", LEARNED, 4, 4)]) == ""
+    assert learned_reading([cell("yukim", DEFAULT_POLICY, 4, 4)]) == ""
 
 
 def test_the_reading_covers_every_protocol_and_states_the_counts():
-    cells = [cell("unseen", "warping", 3, 12), cell("unseen", LEARNED, 10, 12),
+    cells = [cell("unseen", "warping", 3, 12), cell("unseen", DEFAULT_POLICY, 10, 12),
              cell("yukim", "random", 0, 4), cell("yukim", "distance", 0, 4)]
     text = reading(cells)
-    assert f"- unseen: {LEARNED} 83%" in text and "- yukim: no method" in text
+    assert f"- unseen: {DEFAULT_POLICY} 83%" in text and "- yukim: no method" in text
     assert "On held-out worlds (unseen)" in text and "4-12 episodes" in text
     table = headline_table(cells)
     assert "| method | unseen (n=12) | yukim (n=4) |" in table
     assert "| random |  | 0 [0, 49] |" in table
+
+
+@pytest.mark.slow                      # about 20 s: two pools of spawned workers
+def test_cells_run_whole_by_worker_processes_give_the_in_process_cells_and_resume(tmp_path):
+    import json
+
+    from homing_train.harness.matrix import run_matrix
+    from homing_train.harness.protocols import protocol
+
+    hong = [protocol("hong1991")]
+    serial = run_matrix(hong, tmp_path / "serial", {"hong1991": 2}, 1, ["oracle", "snapshot"],
+                        progress=False)
+    by_cell = run_matrix(hong, tmp_path / "cells", {"hong1991": 2}, 2, ["oracle", "snapshot"],
+                         by_cell=True)
+    assert [(c.method, c.summary["success_rate"], c.summary["spl"]) for c in by_cell] == \
+        [(c.method, c.summary["success_rate"], c.summary["spl"]) for c in serial]
+    episodes = tmp_path / "cells" / "hong1991" / "oracle" / "hallway_1_ft.json"
+    before = [e["wall_time"] for e in json.loads(episodes.read_text())["episodes"]]
+    run_matrix(hong, tmp_path / "cells", {"hong1991": 2}, 2, ["oracle", "snapshot"],
+               resume=True, by_cell=True)
+    assert [e["wall_time"] for e in json.loads(episodes.read_text())["episodes"]] == before
+    assert len(json.loads((tmp_path / "cells" / "matrix.json").read_text())) == 2
