@@ -133,7 +133,7 @@ BAD_COMMANDS = [   # (module of the command, arguments)
     ("homing_train.harness.suite", ["--methods", "oracle", "--out", "/dev/null"]),
     ("homing_train.harness.compare", ["{tmp}/missing.json", "--out", "/dev/null"]),
     ("homing_train.harness.demo", ["--out", "/dev/null"]),
-    ("homing_train.harness.suite", ["--methods", "bearing", "--out", "{tmp}/suite"]),
+    ("homing_train.harness.suite", ["--arena", "--methods", "bearing", "--out", "{tmp}/suite"]),
     ("homing_train.harness.suite", ["--protocols", "hong1991", "--methods", "multires",
                                     "--out", "{tmp}/m"]),
     ("homing_train.harness.eval_command", ["--protocol", "hong1991", "--policy", "multires",
