@@ -41,6 +41,7 @@ from tqdm import tqdm
 
 import homing_gym  # noqa: F401  (registers the envs)
 from homing_gym.cli import command_parser, worker_count
+from homing_gym.outputs import output_file_argument, write_text_atomic
 from homing_gym.scenes import Landmark, MeshScene, Scene, scene_factory, square_walls
 from homing_gym.scenes.tussocks import tussock_blades
 
@@ -298,7 +299,9 @@ def main(argv: list[str] | None = None) -> int:
                              "10,290 triangles; mesh10k: a mesh world of 9,650 triangles) or "
                              "any scene: a scene name (also one --import registers) or "
                              "mesh:PATH")
-    parser.add_argument("--json", help="also write the results to this JSON file")
+    parser.add_argument("--json", type=output_file_argument,
+                        help="also write the results to this JSON file (checked before the "
+                        "measuring starts, replaced in one step at the end)")
     parser.add_argument("--resets", type=int, default=0, metavar="N",
                         help="also time N resets (x 5 blocks) in each procedural world, "
                              "with a new world every time and in the same world")
@@ -309,18 +312,12 @@ def main(argv: list[str] | None = None) -> int:
         measured = configs(args.renderers, args.shapes, args.worlds)
     except ValueError as err:
         parser.error(f"--worlds: {err}")
-    if args.json:                       # before the minutes of measuring, not after them
-        try:
-            open(args.json, "w").close()
-        except OSError as err:
-            parser.error(f"--json {args.json!r}: cannot write it ({err.strerror})")
     results = run_configs(measured, args.steps, args.workers)
     print(format_table(results))
     if args.resets:
         print(reset_table(args.resets))
     if args.json:
-        with open(args.json, "w") as f:
-            json.dump([_record(r) for r in results], f, indent=2)
+        write_text_atomic(args.json, json.dumps([_record(r) for r in results], indent=2))
     return 0
 
 

@@ -62,7 +62,7 @@ from homing_baselines.bearing_sim import (ReachabilityMap, SimConfig, circumcirc
 from homing_gym.cli import command_parser, seed_value, worker_count  # noqa: E402
 from homing_train.figures import MEASURED_WITH  # noqa: E402
 from homing_train.harness.policies import parse_params  # noqa: E402
-from homing_train.outputs import output_dir_argument  # noqa: E402
+from homing_gym.outputs import output_dir_argument  # noqa: E402
 
 #: The landmark triangle of the figures (m): scalene, about 2 m a side.
 LANDMARKS = np.array([[-1.0, -0.6], [1.2, -0.5], [0.2, 1.1]])

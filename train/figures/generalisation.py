@@ -31,7 +31,7 @@ from homing_train.harness.evaluate import EpisodeRecord, EvalResult
 from homing_train.harness.matrix import setting_stem
 from homing_train.harness.metrics import wilson_interval
 from homing_train.harness.palette import method_color
-from homing_train.outputs import output_dir_argument
+from homing_gym.outputs import output_dir_argument
 
 #: Map tiles (pixels) of ``failures.png``.
 TILE = 220

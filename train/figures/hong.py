@@ -34,7 +34,7 @@ from homing_train.figures import MEASURED_WITH
 from homing_train.harness.rollout import prepare_policy, rollout
 from homing_train.harness.field import homing_field, plot_field
 from homing_train.harness.policies import policy_spec
-from homing_train.outputs import output_dir_argument
+from homing_gym.outputs import output_dir_argument
 
 PANORAMA = (60, 360)   # 1 deg per column, Hong's sampling interval
 LOCAL = "homing_gym/LocalHoming-v0"

@@ -36,7 +36,7 @@ from homing_gym.scenes.base import clearance
 from homing_gym.teaching import FeatureMap
 from homing_train.figures import MEASURED_WITH
 from homing_train.harness.rollout import prepare_policy, rollout
-from homing_train.outputs import output_dir_argument
+from homing_gym.outputs import output_dir_argument
 
 ENV_ID = "homing_gym/WorkLocations-v0"
 LOCATIONS = ("home", "kitchen", "bedroom")

@@ -17,7 +17,7 @@ import numpy as np
 import homing_gym  # noqa: F401  (registers the env ids)
 from homing_gym.cli import command_parser, seed_value
 from homing_gym.scenes import available_scenes
-from homing_train.outputs import output_dir_argument
+from homing_gym.outputs import output_dir_argument
 
 
 def side_by_side(scene: str, seed: int, shape: tuple[int, int]) -> tuple[np.ndarray, float]:

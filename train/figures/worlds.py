@@ -22,7 +22,7 @@ from homing_gym.cli import command_parser
 from homing_gym.scenes.mesh_example import write_example_room
 from homing_gym.render.topdown import (BG, ROBOT, MapCanvas, labelled, draw_pose, draw_scale_bar,
                                        draw_scene)
-from homing_train.outputs import output_dir_argument
+from homing_gym.outputs import output_dir_argument
 
 PANORAMA = (60, 360)
 

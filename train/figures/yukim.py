@@ -58,7 +58,7 @@ from homing_gym.render.topdown import HOME, MapCanvas, draw_pose, draw_scene  # 
 from homing_train.harness.metrics import wilson_interval  # noqa: E402
 from homing_train.figures import MEASURED_WITH  # noqa: E402
 from homing_train.harness.protocols import ring_starts  # noqa: E402
-from homing_train.outputs import checked_output_dir, checked_output_file  # noqa: E402
+from homing_gym.outputs import checked_output_dir, checked_output_file  # noqa: E402
 
 ENV_ID = "homing_gym/LocalHoming-v0"
 HOME_POSE = (0.0, 0.0, 0.0)  # the nest: arena centre, among the four cylinders

@@ -30,7 +30,7 @@ from homing_train.harness.evaluate import (EvalResult, env_default,  # noqa: E40
 from homing_train.harness.matrix import episode_seconds  # noqa: E402
 from homing_train.harness.palette import (HOME_MARK, START_MARK, method_color,  # noqa: E402
                                           method_color_255)
-from homing_train.outputs import (OutputLock, checked_output_dir,  # noqa: E402
+from homing_gym.outputs import (OutputLock, checked_output_dir,  # noqa: E402
                                   output_dir_argument, write_text_atomic)
 
 

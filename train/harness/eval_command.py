@@ -28,7 +28,7 @@ from homing_train.harness.evaluate import (DEFAULT_ENV, add_backend_arguments,
 from homing_train.harness.matrix import run_cell
 from homing_train.harness.policies import recorded_settings
 from homing_train.harness.protocols import PROTOCOLS, protocol
-from homing_train.outputs import (OutputLock, checked_output_dir, checked_output_file,
+from homing_gym.outputs import (OutputLock, checked_output_dir, checked_output_file,
                                   output_file_argument, write_text_atomic)
 from homing_train.pool import WorkerDiedError, end_stopped_command
 

@@ -38,7 +38,7 @@ from homing_train.harness import metrics
 from homing_train.harness.policies import (PolicySpec, parse_params, policy_spec,
                                            recorded_settings)
 from homing_train.harness.rollout import prepare_policy, rollout
-from homing_train.outputs import OutputLock, atomic_path, write_text_atomic
+from homing_gym.outputs import OutputLock, atomic_path, write_text_atomic
 from homing_train.pool import pool_results, stop_on_signals
 
 SCHEMA = 1

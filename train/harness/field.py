@@ -46,7 +46,7 @@ from homing_train.harness.palette import HOME_MARK  # noqa: E402
 from homing_train.harness.policies import PolicySpec, policy_spec  # noqa: E402
 from homing_train.harness.protocols import PROTOCOLS, protocol  # noqa: E402
 from homing_train.harness.rollout import prepare_policy, rollout  # noqa: E402
-from homing_train.outputs import (OutputLock, atomic_path,  # noqa: E402
+from homing_gym.outputs import (OutputLock, atomic_path,  # noqa: E402
                                   output_file_argument, write_text_atomic)
 from homing_train.pool import WorkerDiedError, end_stopped_command  # noqa: E402
 

@@ -58,7 +58,7 @@ from homing_train.harness.matrix import (BASE_PERIOD, applicable, equal_time_kwa
                                          matrix_markdown, run_matrix)
 from homing_train.harness.policies import DEFAULT_POLICY, shipped_policies
 from homing_train.harness.protocols import PROTOCOLS, protocol
-from homing_train.outputs import OutputLock, output_dir_argument
+from homing_gym.outputs import OutputLock, output_dir_argument
 from homing_train.pool import WorkerDiedError, end_stopped_command
 
 #: ``--workers``' default: 2 where the machine has 2 cores or more.

@@ -1,6 +1,6 @@
 """Saves of a ``homing-train`` run that survive a crash: every model zip and
 ``evaluations.npz`` is written to a temporary file beside it and renamed over it
-(:func:`homing_train.outputs.atomic_path`), so a kill, a full disk or an error mid-save
+(:func:`homing_gym.outputs.atomic_path`), so a kill, a full disk or an error mid-save
 leaves the old file whole (or none), never a torn one that ``--resume`` cannot read."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from pathlib import Path
 from stable_baselines3.common.base_class import BaseAlgorithm
 from stable_baselines3.common.callbacks import BaseCallback, CheckpointCallback, EvalCallback
 
-from homing_train.outputs import atomic_path
+from homing_gym.outputs import atomic_path
 
 
 def save_model(model: BaseAlgorithm, path: Path) -> None:

@@ -105,8 +105,15 @@ def last_stage(path: Path) -> tuple[int, list[dict]]:
     there is no file)."""
     if not Path(path).is_file():
         return 0, []
-    history = json.loads(Path(path).read_text())["stages"]
-    return (history[-1]["stage"] if history else 0), history
+    try:
+        history = json.loads(Path(path).read_text())["stages"]
+        stage = history[-1]["stage"] if history else 0
+    except (ValueError, KeyError, TypeError, IndexError) as err:
+        raise ValueError(f"{path}: not a curriculum record ({type(err).__name__}: {err}); "
+                         f"expected {{\"stages\": [{{\"stage\": N, ...}}, ...]}}") from None
+    if not isinstance(stage, int) or isinstance(stage, bool) or stage < 0:
+        raise ValueError(f"{path}: stage {stage!r} is not a whole number >= 0")
+    return stage, history
 
 
 def mark_stages(ax, stages: list[dict]) -> None:

@@ -11,7 +11,7 @@ from pathlib import Path
 from stable_baselines3.common.callbacks import BaseCallback
 
 from homing_train.learning.curriculum import HOOK, CurriculumSettings
-from homing_train.outputs import write_text_atomic
+from homing_gym.outputs import write_text_atomic
 
 
 class CurriculumCallback(BaseCallback):

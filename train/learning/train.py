@@ -61,7 +61,7 @@ from homing_train.learning.thread_split import phase_threads
 from homing_train.learning.ppo_settings import (PPO_KEYS, check_device, check_ppo,
                                                extractor_arguments, ppo_arguments)
 from homing_train.learning.pretrain import pretrain
-from homing_train.outputs import OutputLock, atomic_path, checked_output_dir, write_text_atomic
+from homing_gym.outputs import OutputLock, atomic_path, checked_output_dir, write_text_atomic
 
 HYPERPARAMS = Path(str(resources.files("homing_train.learning") / "hyperparams" / "ppo.yml"))
 #: The records (``NAME.yml``) of policies no longer shipped, for ``--recipe NAME``.

@@ -63,7 +63,7 @@ def held_lock():
 
     def hold(path: str) -> None:
         child = subprocess.Popen(
-            [sys.executable, "-c", "import sys; from homing_train.outputs import OutputLock; "
+            [sys.executable, "-c", "import sys; from homing_gym.outputs import OutputLock; "
              f"OutputLock({path!r}).acquire(); print('held', flush=True); sys.stdin.read()"],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
         children.append(child)

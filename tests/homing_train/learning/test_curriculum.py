@@ -229,3 +229,18 @@ def test_stage_marks_share_a_label_when_too_close_to_read_apart():
     plt.close(fig)
     assert stage_key(stages[:2]).splitlines() == [
         "stage 0 from 0k: 0.3-1.5 m, radius 0.15 m", "stage 1 from 180k: 0.3-1.5 m, radius 0.15 m"]
+
+
+@pytest.mark.parametrize("text", ["{", "[]", '{"stages": 3}', '{"stages": [{"x": 1}]}',
+                                  '{"stages": [{"stage": -1}]}', '{"stages": [{"stage": true}]}'])
+def test_a_broken_curriculum_record_is_one_error_naming_the_file(tmp_path, text):
+    path = tmp_path / "curriculum.json"
+    path.write_text(text)
+    with pytest.raises(ValueError, match="curriculum.json"):
+        last_stage(path)
+
+
+def test_a_curriculum_record_gives_its_last_stage(tmp_path):
+    path = tmp_path / "curriculum.json"
+    path.write_text(json.dumps({"stages": [{"stage": 0}, {"stage": 2}]}))
+    assert last_stage(path) == (2, [{"stage": 0}, {"stage": 2}])

@@ -11,7 +11,7 @@ import yaml
 
 from homing_train.learning.checkpoints import save_model
 from homing_train.learning.train import latest_checkpoint, main
-from homing_train.outputs import OutputLock
+from homing_gym.outputs import OutputLock
 
 # a tiny run: 36x64 panoramas, one env, a rollout of 64 steps, checkpoints every 128
 TINY = ["--env-kwargs", json.dumps({"panorama_shape": [36, 64], "max_episode_steps": 16}),

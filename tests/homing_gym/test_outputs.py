@@ -6,7 +6,7 @@ import sys
 
 import pytest
 
-from homing_train.outputs import (OutputBusyError, OutputLock, checked_output_dir,
+from homing_gym.outputs import (OutputBusyError, OutputLock, checked_output_dir,
                                   checked_output_file, write_text_atomic)
 
 
@@ -53,7 +53,7 @@ def test_an_atomic_write_leaves_the_old_file_on_error(tmp_path, monkeypatch):
 def test_a_second_writer_is_refused_and_the_lock_frees(tmp_path):
     out = str(tmp_path / "r.json")
     holder = subprocess.Popen(
-        [sys.executable, "-c", "import sys, time; from homing_train.outputs import OutputLock;"
+        [sys.executable, "-c", "import sys, time; from homing_gym.outputs import OutputLock;"
          f"OutputLock({out!r}).acquire(); print('held', flush=True); time.sleep(60)"],
         stdout=subprocess.PIPE, text=True)
     try:
@@ -72,7 +72,7 @@ def test_a_second_writer_is_refused_and_the_lock_frees(tmp_path):
 def test_the_argparse_types_end_a_command_at_parse_time(tmp_path, capsys):
     import argparse
 
-    from homing_train.outputs import output_dir_argument, output_file_argument
+    from homing_gym.outputs import output_dir_argument, output_file_argument
 
     (tmp_path / "f.txt").write_text("x")
     parser = argparse.ArgumentParser(prog="cmd")
