@@ -153,14 +153,16 @@ def test_controller_reaches_home_from_1m_in_arena(free_start):
     the paper's two-snapshot nest map (``goal_step``). Three of four must succeed: from
     the start towards the wall, only two landmarks get distances in both maps for
     several steps, and with two landmarks a wrong cyclic shift fits as well as the right
-    one (docs/yu_kim.md), so that episode fails (a limit of the method, not hidden)."""
+    one (docs/yu_kim.md), so that episode fails (a limit of the method, not hidden).
+    Reaching is the claim here (``success_on="reach"``); under the stop rule the
+    ``yukim`` protocol scores it."""
     gym = pytest.importorskip("gymnasium")
     import homing_gym  # noqa: F401
     from homing_train.harness.evaluate import run_episode
     from homing_train.harness.rollout import prepare_policy
 
     env = gym.make("homing_gym/LocalHoming-v0", obs_keys=("panorama", "goal", "goal_step"),
-                   max_episode_steps=300)
+                   max_episode_steps=300, success_on="reach")
     controller = DistanceController()
     prepare_policy(controller, env)
     home = (0.05, -0.1, 0.4)
