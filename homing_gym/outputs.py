@@ -127,6 +127,15 @@ def write_bytes_atomic(path: str, data: bytes) -> None:
         f.write(data)
 
 
+def save_figure(fig, path, **savefig_kwargs) -> None:
+    """Save the matplotlib figure ``fig`` to ``path`` atomically (:func:`atomic_path`),
+    in the format its extension names (``savefig_kwargs``: ``dpi``, ``bbox_inches``...)."""
+    path = os.fspath(path)
+    fmt = os.path.splitext(path)[1].lstrip(".").lower() or None
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format=fmt, **savefig_kwargs)
+
+
 def lock_path(path: str) -> str:
     """The lock file of an output: ``.NAME.lock`` beside it."""
     full = os.path.abspath(path)

@@ -7,7 +7,7 @@ import sys
 import pytest
 
 from homing_gym.outputs import (OutputBusyError, OutputLock, checked_output_dir,
-                                  checked_output_file, write_text_atomic)
+                                checked_output_file, save_figure, write_text_atomic)
 
 
 @pytest.mark.parametrize("bad", ["", "   "])
@@ -85,3 +85,27 @@ def test_the_argparse_types_end_a_command_at_parse_time(tmp_path, capsys):
         assert end.value.code == 2
         last = capsys.readouterr().err.strip().splitlines()[-1]
         assert last.startswith("cmd: error: argument") and ("empty" in last or "file" in last)
+
+
+def test_a_figure_is_saved_in_its_extensions_format_or_not_at_all(tmp_path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots()
+    ax.plot([0, 1], [0, 1])
+    save_figure(fig, tmp_path / "a.png", dpi=20)
+    save_figure(fig, str(tmp_path / "a.svg"))
+    assert (tmp_path / "a.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert b"<svg" in (tmp_path / "a.svg").read_bytes()[:500]
+    old = (tmp_path / "a.png").read_bytes()
+
+    def torn_save(path, **kwargs):                 # half a file, then a full disk
+        open(path, "wb").write(b"\x89PNG")
+        raise OSError(28, "No space left on device")
+    fig.savefig = torn_save
+    with pytest.raises(OSError):
+        save_figure(fig, tmp_path / "a.png")
+    plt.close(fig)
+    assert (tmp_path / "a.png").read_bytes() == old
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.png", "a.svg"]

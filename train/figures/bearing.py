@@ -62,7 +62,7 @@ from homing_baselines.bearing_sim import (ReachabilityMap, SimConfig, circumcirc
 from homing_gym.cli import command_parser, seed_value, worker_count  # noqa: E402
 from homing_train.figures import MEASURED_WITH  # noqa: E402
 from homing_train.harness.policies import parse_params  # noqa: E402
-from homing_gym.outputs import output_dir_argument  # noqa: E402
+from homing_gym.outputs import output_dir_argument, save_figure  # noqa: E402
 
 #: The landmark triangle of the figures (m): scalene, about 2 m a side.
 LANDMARKS = np.array([[-1.0, -0.6], [1.2, -0.5], [0.2, 1.1]])
@@ -163,7 +163,7 @@ def reachability(out: str, grid: int = 81, extent: float = 4.0,
         plot_map(ax, m, f"{TITLES[law]}: reached goals gray")
         ax.legend(loc="lower left", fontsize=7, framealpha=0.9)
         fig.tight_layout()
-        fig.savefig(os.path.join(out, f"reachability_{law}.png"), dpi=90)
+        save_figure(fig, os.path.join(out, f"reachability_{law}.png"), dpi=90)
         plt.close(fig)
     fig, axes = plt.subplots(1, 3, figsize=(14, 5))
     for ax, law in zip(axes, LAWS):
@@ -172,7 +172,7 @@ def reachability(out: str, grid: int = 81, extent: float = 4.0,
     fig.suptitle(f"Reachable goals (gray) from A = {tuple(start)}, "
                  f"step {cfg.step} m, success within {cfg.success_radius} m", fontsize=11)
     fig.tight_layout()
-    fig.savefig(os.path.join(out, "reachability.png"), dpi=80)
+    save_figure(fig, os.path.join(out, "reachability.png"), dpi=80)
     plt.close(fig)
     record = {"landmarks": LANDMARKS.tolist(), "start": list(start), "grid": grid,
               "extent": extent, "config": {"step": cfg.step, "max_steps": cfg.max_steps,
@@ -420,7 +420,7 @@ def pixel_reachability(out: str, spacing: float = 1.2, max_steps: int = 600,
                  f"(stop within {fail_cm:.0f} cm, {max_steps} steps)", fontsize=11)
     fig.tight_layout()
     os.makedirs(out, exist_ok=True)
-    fig.savefig(os.path.join(out, "pixel_reachability.png"), dpi=80)
+    save_figure(fig, os.path.join(out, "pixel_reachability.png"), dpi=80)
     plt.close(fig)
     with open(os.path.join(out, "pixel_reachability.json"), "w") as f:
         json.dump({"start": list(PIXEL_START), "spacing": spacing, "max_steps": max_steps,

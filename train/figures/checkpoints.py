@@ -28,7 +28,7 @@ import numpy as np
 from homing_gym.cli import command_parser
 from homing_train.harness.matrix import run_cell
 from homing_train.harness.protocols import PROTOCOLS, protocol
-from homing_gym.outputs import output_dir_argument
+from homing_gym.outputs import output_dir_argument, save_figure
 
 _CHECKPOINT = re.compile(r"ppo_(\d+)_steps\.zip$")
 #: Plot position (env steps) of a run's warm start, drawn before its first PPO step.
@@ -153,7 +153,7 @@ def plot(results: dict[str, list[CheckpointScore]], runs: dict[str, Path],
     fig.suptitle(f"success against training steps (Wilson 95% intervals on {protocol_name})",
                  fontsize=9)
     fig.tight_layout()
-    fig.savefig(path)
+    save_figure(fig, path)
     plt.close(fig)
 
 

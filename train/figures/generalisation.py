@@ -31,7 +31,7 @@ from homing_train.harness.evaluate import EpisodeRecord, EvalResult
 from homing_train.harness.matrix import setting_stem
 from homing_train.harness.metrics import wilson_interval
 from homing_train.harness.palette import method_color
-from homing_gym.outputs import output_dir_argument
+from homing_gym.outputs import output_dir_argument, save_figure
 
 #: Map tiles (pixels) of ``failures.png``.
 TILE = 220
@@ -110,7 +110,7 @@ def per_scene_figure(results: dict[str, list[SceneResult]], path: Path) -> None:
               bbox_to_anchor=(0.5, -0.1), frameon=False)
     ax.spines[["top", "right"]].set_visible(False)
     fig.tight_layout()
-    fig.savefig(path, bbox_inches="tight")
+    save_figure(fig, path, bbox_inches="tight")
     plt.close(fig)
 
 

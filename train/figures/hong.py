@@ -34,7 +34,7 @@ from homing_train.figures import MEASURED_WITH
 from homing_train.harness.rollout import prepare_policy, rollout
 from homing_train.harness.field import homing_field, plot_field
 from homing_train.harness.policies import policy_spec
-from homing_gym.outputs import output_dir_argument
+from homing_gym.outputs import output_dir_argument, save_figure
 
 PANORAMA = (60, 360)   # 1 deg per column, Hong's sampling interval
 LOCAL = "homing_gym/LocalHoming-v0"
@@ -150,7 +150,7 @@ def plot_signature(out: str, seed: int = 3) -> dict[str, Any]:
     ax1.set_xlim(0, 360)
     ax1.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(os.path.join(out, "signature.png"))
+    save_figure(fig, os.path.join(out, "signature.png"))
     plt.close(fig)
     return {"correlation": float(np.corrcoef(a, b)[0, 1]),
             "mean_abs_difference": float(np.abs(a - b).mean()),

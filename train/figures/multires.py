@@ -36,7 +36,7 @@ from homing_gym.scenes.base import clearance
 from homing_gym.teaching import FeatureMap
 from homing_train.figures import MEASURED_WITH
 from homing_train.harness.rollout import prepare_policy, rollout
-from homing_gym.outputs import output_dir_argument
+from homing_gym.outputs import output_dir_argument, save_figure
 
 ENV_ID = "homing_gym/WorkLocations-v0"
 LOCATIONS = ("home", "kitchen", "bedroom")
@@ -205,7 +205,7 @@ def main(argv: list[str] | None = None) -> int:
         axes[0].legend()
         fig.suptitle("Self-localisation within 0.5 m of the work locations (paper: <10 cm, <2 deg)")
         fig.tight_layout()
-        fig.savefig(out / "localisation.png", dpi=110)
+        save_figure(fig, out / "localisation.png", dpi=110)
         (out / "localisation.json").write_text(json.dumps(results, indent=1))
     else:
         rows = travel_experiment(args.episodes, args.seed, args.daily_changes)
@@ -227,7 +227,7 @@ def main(argv: list[str] | None = None) -> int:
         ax.set_ylabel("share of episodes")
         ax.legend(fontsize=8)
         fig.tight_layout()
-        fig.savefig(out / f"travel{tag}.png", dpi=110)
+        save_figure(fig, out / f"travel{tag}.png", dpi=110)
     return 0
 
 

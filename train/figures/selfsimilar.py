@@ -58,7 +58,7 @@ from homing_baselines.camera_models import PerspectiveModel
 from homing_baselines.selfsimilar_detector import DetectorConfig, detect_landmarks
 from homing_gym.cli import command_parser
 from homing_train.figures import MEASURED_WITH
-from homing_gym.outputs import output_dir_argument
+from homing_gym.outputs import output_dir_argument, save_figure
 
 #: Frames per second reported by the paper (§3.3) with the speed-ups.
 PAPER_FPS = {(640, 480): 36.0, (320, 240): 81.0}
@@ -251,7 +251,7 @@ def detection_figure(rows: list[dict], path: str) -> None:
            title="Detection in the 320 x 240 view (w = 22, k = 3)")
     ax.legend(title="off the normal", fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 

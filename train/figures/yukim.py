@@ -58,7 +58,8 @@ from homing_gym.render.topdown import HOME, MapCanvas, draw_pose, draw_scene  # 
 from homing_train.harness.metrics import wilson_interval  # noqa: E402
 from homing_train.figures import MEASURED_WITH  # noqa: E402
 from homing_train.harness.protocols import ring_starts  # noqa: E402
-from homing_gym.outputs import checked_output_dir, checked_output_file  # noqa: E402
+from homing_gym.outputs import (checked_output_dir, checked_output_file,  # noqa: E402
+                                save_figure)
 
 ENV_ID = "homing_gym/LocalHoming-v0"
 HOME_POSE = (0.0, 0.0, 0.0)  # the nest: arena centre, among the four cylinders
@@ -234,7 +235,7 @@ def plot_fields(scene, samples: list[Sample], grid: float, path: str) -> dict:
         "aae_deg": aae_all[0], "homeward": aae_all[1], "no_decision": aae_all[2]}
     fig.suptitle("Fig. 4-like vector maps (arena, no compass; blue dots: no decision)")
     fig.tight_layout(rect=(0, 0, 1, 0.95))
-    fig.savefig(path)
+    save_figure(fig, path)
     plt.close(fig)
     return stats
 
@@ -271,7 +272,7 @@ def plot_errors(samples: list[Sample], path: str, width: float = 0.2) -> dict:
         ax.legend(fontsize=8)
     fig.suptitle("Fig. 5-like: mean with 95% t-intervals, no compass")
     fig.tight_layout()
-    fig.savefig(path)
+    save_figure(fig, path)
     plt.close(fig)
     return out
 
@@ -287,7 +288,7 @@ def plot_distance_error(rel: np.ndarray, path: str) -> dict:
     ax.set_title(f"median |error| {stats['median_pct']:.1f}%, 90th pct "
                  f"{stats['p90_pct']:.1f}% (n={pct.size})", fontsize=10)
     fig.tight_layout()
-    fig.savefig(path)
+    save_figure(fig, path)
     plt.close(fig)
     return stats
 
@@ -354,7 +355,7 @@ def plot_success(results: dict, trials: int, max_steps: int, path: str) -> None:
     ax.set_title(f"Fig. 6-like: fixed nest at the arena centre, no compass\n"
                  f"({max_steps} steps max; 95% Wilson intervals)", fontsize=10)
     fig.tight_layout()
-    fig.savefig(path)
+    save_figure(fig, path)
     plt.close(fig)
 
 

@@ -31,7 +31,7 @@ from homing_train.harness.matrix import episode_seconds  # noqa: E402
 from homing_train.harness.palette import (HOME_MARK, START_MARK, method_color,  # noqa: E402
                                           method_color_255)
 from homing_gym.outputs import (OutputLock, checked_output_dir,  # noqa: E402
-                                  output_dir_argument, write_text_atomic)
+                                output_dir_argument, save_figure, write_text_atomic)
 
 
 
@@ -171,7 +171,7 @@ def _finish(fig, ax, title: str, path: str) -> None:
     ax.grid(alpha=0.3)
     ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, frameon=False)
     fig.tight_layout()
-    fig.savefig(path)
+    save_figure(fig, path)
     plt.close(fig)
 
 
@@ -254,7 +254,7 @@ def plot_trajectories(results: Sequence[EvalResult], seeds: Sequence[int], path:
     fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 5), fontsize=8,
                frameon=False)
     fig.tight_layout(rect=(0, 0.12 if len(handles) > 5 else 0.07, 1, 1))
-    fig.savefig(path)
+    save_figure(fig, path)
     plt.close(fig)
 
 

@@ -34,7 +34,7 @@ from homing_gym.render.panorama import bearing_column  # noqa: E402
 from homing_train import DEFAULT_ENV  # noqa: E402
 from homing_train.harness.evaluate import check_env_id  # noqa: E402
 from homing_train.harness.rollout import prepare_policy, rollout  # noqa: E402
-from homing_gym.outputs import output_dir_argument  # noqa: E402
+from homing_gym.outputs import output_dir_argument, save_figure  # noqa: E402
 
 #: The observation keys the views figure shows (added to any ``obs_keys`` given).
 VIEW_KEYS = ("panorama", "goal", "omni", "signature")
@@ -86,7 +86,7 @@ def views_figure(env: gym.Env, seed: int, path: Path) -> None:
     ax3.imshow(ring)
     ax3.set_title("omni ring image (heading up)")
     ax3.axis("off")
-    fig.savefig(path, dpi=90)
+    save_figure(fig, path, dpi=90)
     plt.close(fig)
 
 

@@ -46,8 +46,8 @@ from homing_train.harness.palette import HOME_MARK  # noqa: E402
 from homing_train.harness.policies import PolicySpec, policy_spec  # noqa: E402
 from homing_train.harness.protocols import PROTOCOLS, protocol  # noqa: E402
 from homing_train.harness.rollout import prepare_policy, rollout  # noqa: E402
-from homing_gym.outputs import (OutputLock, atomic_path,  # noqa: E402
-                                  output_file_argument, write_text_atomic)
+from homing_gym.outputs import (OutputLock, output_file_argument,  # noqa: E402
+                                save_figure, write_text_atomic)
 from homing_train.pool import WorkerDiedError, end_stopped_command  # noqa: E402
 
 # colour-blind-safe (Okabe & Ito): returned blue, not returned vermillion, unknown grey
@@ -213,8 +213,7 @@ def plot_field(result: FieldResult, path: str, size: int = 480) -> None:
                   f"(blue: returned, vermillion: not)")
     ax.set_title(title, fontsize=10)
     fig.tight_layout()
-    with atomic_path(path) as tmp:          # the format named by the extension
-        fig.savefig(tmp, format=os.path.splitext(path)[1].lstrip(".").lower() or None)
+    save_figure(fig, path)
     plt.close(fig)
 
 

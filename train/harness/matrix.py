@@ -53,7 +53,7 @@ from homing_train.harness.policies import (ShippedPolicy, recorded_settings,  # 
 from homing_train.harness.metrics import aggregate_success, wilson_interval  # noqa: E402
 from homing_train.harness.protocols import (POLICIES, PROTOCOLS, Protocol,  # noqa: E402
                                             episodes_key)
-from homing_gym.outputs import write_text_atomic  # noqa: E402
+from homing_gym.outputs import save_figure, write_text_atomic  # noqa: E402
 from homing_train.pool import pool_results  # noqa: E402
 
 #: The control period (s) that protocols count ``max_episode_steps`` in.
@@ -531,7 +531,7 @@ def plot_matrix(cells: Sequence[Cell], path: str) -> None:
                  "episodes; blank: not applicable", fontsize=8)
     fig.colorbar(image, ax=ax, label="success %")
     fig.tight_layout()
-    fig.savefig(path)
+    save_figure(fig, path)
     plt.close(fig)
 
 

@@ -61,7 +61,8 @@ from homing_train.learning.thread_split import phase_threads
 from homing_train.learning.ppo_settings import (PPO_KEYS, check_device, check_ppo,
                                                extractor_arguments, ppo_arguments)
 from homing_train.learning.pretrain import pretrain
-from homing_gym.outputs import OutputLock, atomic_path, checked_output_dir, write_text_atomic
+from homing_gym.outputs import (OutputLock, checked_output_dir, save_figure,
+                                write_text_atomic)
 
 HYPERPARAMS = Path(str(resources.files("homing_train.learning") / "hyperparams" / "ppo.yml"))
 #: The records (``NAME.yml``) of policies no longer shipped, for ``--recipe NAME``.
@@ -465,8 +466,7 @@ def plot_learning_curve(run: Path) -> Path | None:
     mark_stages(ax, stages)
     ax.set_title(f"{run.name}: evaluation on held-out seeds")
     out = run / "learning_curve.png"
-    with atomic_path(out) as tmp:
-        fig.savefig(tmp, dpi=100, format="png")
+    save_figure(fig, out, dpi=100)
     plt.close(fig)
     return out
 
