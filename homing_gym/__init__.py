@@ -7,6 +7,8 @@
 
 from __future__ import annotations
 
+from functools import partial
+
 import gymnasium as gym
 
 from homing_gym.native_output import native_output_captured
@@ -27,11 +29,21 @@ _ENVS = {
 ENV_IDS: tuple[str, ...] = tuple(_ENVS)
 
 
+def _native_vector_env(env_id: str, **kwargs):
+    """The vector entry point of every id: ``gym.make_vec(env_id, num_envs=N,
+    vectorization_mode="vector_entry_point", **kwargs)`` makes a
+    :class:`homing_gym.vector.native.NativeVectorEnv`."""
+    from homing_gym.vector.native import NativeVectorEnv
+
+    return NativeVectorEnv(env_id, **kwargs)
+
+
 def register_envs() -> None:
     """Register every env id with Gymnasium; calling it again changes nothing."""
     for env_id, (entry_point, steps) in _ENVS.items():
         if env_id not in gym.registry:
-            gym.register(id=env_id, entry_point=entry_point, max_episode_steps=steps)
+            gym.register(id=env_id, entry_point=entry_point, max_episode_steps=steps,
+                         vector_entry_point=partial(_native_vector_env, env_id))
 
 
 register_envs()

@@ -21,7 +21,8 @@ from gymnasium import spaces
 from homing_gym.actions import DiscreteAction
 from homing_gym.config import EnvConfig, env_config
 from homing_gym.geometry import finite_pose, to_frame
-from homing_gym.observations import CORE_KEYS, ObservationKey, Sight, goal_step_key
+from homing_gym.observations import (CORE_KEYS, PANORAMA_KEYS, ObservationKey, Sight,
+                                     goal_step_key)
 from homing_gym.render.panorama import Lighting, PanoramaCamera, random_lighting
 from homing_gym.paths import occupancy
 from homing_gym.render.perspective import PerspectiveConfig, render_perspective
@@ -285,9 +286,10 @@ class HomingEnv(gym.Env):
         stop = abs(v) < self.stop_threshold and abs(w) < self.stop_threshold
         return float(v), float(w), bool(stop)
 
-    def _observation(self, skip_images: bool = False) -> dict[str, np.ndarray]:
-        """The observation of the current step from the table; after
-        :meth:`skip_next_images`, the rendered keys repeat their last value."""
+    def observation(self, skip_images: bool = False) -> dict[str, np.ndarray]:
+        """The observation of the current step from the table; with ``skip_images`` (as
+        :meth:`advance` returns it after :meth:`skip_next_images`), the rendered keys
+        repeat their last value."""
         sight = Sight(self.camera, lambda: self.panorama, odometry=lambda: self.odometry.estimate,
                       view=lambda size, hfov: self.render_view(size=size, hfov_deg=hfov))
         obs: dict[str, np.ndarray] = {}
@@ -381,9 +383,17 @@ class HomingEnv(gym.Env):
         self.trajectory = [(float(self.pose[0]), float(self.pose[1]))]
         self.collisions = 0
         self.task.on_reset(self._task_context)
-        return self._observation(), self._info()
+        return self.observation(), self._info()
 
     def step(self, action):
+        reward, terminated, info, skip_images = self.advance(action)
+        return self.observation(skip_images), reward, terminated, False, info
+
+    def advance(self, action) -> tuple[float, bool, dict[str, Any], bool]:
+        """:meth:`step` without its observation: the robot moves, the task scores the
+        move; ``(reward, terminated, info, skip_images)``. The observation follows from
+        :meth:`observation` (:mod:`homing_gym.vector` renders the panoramas of many
+        envs in threads between the two)."""
         self._check_open()
         if self.episode is None:
             raise RuntimeError("call reset() before step()")
@@ -406,8 +416,21 @@ class HomingEnv(gym.Env):
         reward = float(sum(rewards.values()))
         if self.render_mode == "human":
             self.render()
-        return (self._observation(skip_images), reward, bool(terminated), False,
-                self._info(collision, success, rewards))
+        return reward, bool(terminated), self._info(collision, success, rewards), skip_images
+
+    @property
+    def reads_panorama(self) -> bool:
+        """Whether the observation reads the current panorama (keys of
+        :data:`~homing_gym.observations.PANORAMA_KEYS`) and the ray caster draws it: then
+        :meth:`render_panorama_now` may run in another thread (the caster's kernels
+        release the GIL), one env at a time."""
+        return self.sim.caster is not None and any(k in PANORAMA_KEYS for k in self.obs_keys)
+
+    def render_panorama_now(self) -> None:
+        """Render the current panorama now (if not yet rendered since the last move), so
+        that the next observation reads it."""
+        if self._panorama is None:
+            self._panorama = self.camera.render(self.sim.client, self.pose, self._lighting)
 
     def render(self):
         self._check_open()

@@ -123,6 +123,9 @@ CORE_KEYS: dict[str, ObservationKey] = {
     "goal_signature": ObservationKey(_signature, _signature_of, goal=True),
 }
 
+#: Keys read from the current pose's panorama (one ray-cast image per step).
+PANORAMA_KEYS = ("panorama", "omni", "signature")
+
 
 def constant_key(space: spaces.Space, value: Callable[[], np.ndarray]) -> ObservationKey:
     """A key whose value a task holds (``value()``), not read from the camera."""

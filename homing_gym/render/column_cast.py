@@ -48,7 +48,7 @@ def _past(v: float, value: float, strict: bool) -> bool:
     return v < value if strict else v <= value
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def _first_past(values: np.ndarray, value: float, strict: bool, guess: int) -> int:
     """First index ``i`` at which the descending ``values`` fall below ``value``
     (``values[i] < value``, or ``<=`` when not ``strict``), or ``len(values)``.
@@ -194,7 +194,7 @@ def _bearing_span(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray, 
             (SPAN + around) * (1 - (away | edge_on)))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def triangle_spans(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
                    origin: np.ndarray, yaw: float, k0: int, k1: int, lo: np.ndarray,
                    hi: np.ndarray, kind: np.ndarray) -> None:
@@ -245,7 +245,7 @@ _ROW_SLACK = 1e-3
  _END_GUESS) = range(15)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def _cut_columns(n: int, p: np.ndarray, H: int, even_rows: bool, top_angle: float,
                  rows_per_radian: float, out: np.ndarray) -> None:
     """For the first ``n`` pairs ``p[:, k]`` (:func:`cast_columns`): the triangle cut
@@ -297,7 +297,7 @@ def _rows_kernel(ties: bool):
     triangle index wins, else the first), compiled apart so that neither pays for the
     other's test."""
 
-    @njit(cache=True, error_model="numpy")
+    @njit(cache=True, error_model="numpy", nogil=True)
     def rows(first: int, end: int, t: int, j: int, jr: int, tan_elev: np.ndarray, a0: float,
              h0: float, a1: float, h1: float, da: float, hit: np.ndarray,
              depth: np.ndarray) -> bool:
@@ -324,7 +324,7 @@ def _rows_kernel(ties: bool):
 _rows, _rows_by_index = _rows_kernel(False), _rows_kernel(True)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def _rows_weighted(first: int, end: int, t: int, j: int, jr: int, tan_elev: np.ndarray,
                    a0: float, h0: float, a1: float, h1: float, da: float, w0: float, w1: float,
                    w2: float, dw0: float, dw1: float, dw2: float, hit: np.ndarray,
@@ -343,7 +343,7 @@ def _rows_weighted(first: int, end: int, t: int, j: int, jr: int, tan_elev: np.n
     return wins
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def _fill_rows(n: int, triangle: np.ndarray, column: np.ndarray, level: np.ndarray,
                cut: np.ndarray, tan_elev: np.ndarray, even_rows: bool, weighted: np.ndarray,
                hit: np.ndarray, weights: np.ndarray, depth: np.ndarray, bound: np.ndarray,
@@ -469,7 +469,7 @@ def triangle_grid(triangles: np.ndarray, normals: np.ndarray, closed: np.ndarray
                      start, box, NEAR_CELLS * LEVEL_FACTOR ** np.arange(levels))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def cast_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
                  index: np.ndarray, top: np.ndarray, start: np.ndarray, box: np.ndarray,
                  reach: np.ndarray, origin: np.ndarray, yaw: float, beta: np.ndarray,
@@ -606,7 +606,7 @@ def _top_tangent(rise: float, near: float, far: float) -> float:
     return tangent + _OCCLUSION_SLACK * (1.0 + abs(tangent))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def _triangle_tangent(rise: float, x0: float, y0: float, x1: float, y1: float, x2: float,
                       y2: float) -> float:
     """:func:`_top_tangent` of a triangle with corners ``(x0, y0)``, ... (relative to the
@@ -616,7 +616,7 @@ def _triangle_tangent(rise: float, x0: float, y0: float, x1: float, y1: float, x
     return _top_tangent(rise, near, far)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def _uncovered(depth: np.ndarray, tan: np.ndarray, reach: np.ndarray, lv: int, j: int,
                bound: np.ndarray) -> float:
     """The tangent of the lowest row of column ``j`` (``inf`` if none) below which
@@ -630,7 +630,7 @@ def _uncovered(depth: np.ndarray, tan: np.ndarray, reach: np.ndarray, lv: int, j
     return tan[r - 1, 0] if r > 0 else np.inf
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def _cells_by_level(box: np.ndarray, reach: np.ndarray, ox: float, oy: float, C: int):
     """``(level, near, far, by_level)`` of the first ``C`` cells seen from ``(ox, oy)``:
     the occlusion level each is tested at (the last of :attr:`Triangles.reach` within
@@ -691,7 +691,7 @@ def _first_uncovered(c: int, box: np.ndarray, start: np.ndarray, top: np.ndarray
     return k
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def _circle_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray,
                     origin: np.ndarray, yaw: float, first: float, step: float, W: int,
                     k0: int, k1: int, ranges: np.ndarray) -> None:
@@ -716,7 +716,7 @@ def _circle_columns(corners: np.ndarray, normals: np.ndarray, closed: np.ndarray
         ranges[3, t] = 0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def _searched_columns(lo: np.ndarray, hi: np.ndarray, kind: np.ndarray, beta: np.ndarray,
                       per_radian: float, k0: int, k1: int, ranges: np.ndarray) -> None:
     """``ranges[:, t]`` for ``k0 <= t < k1``: ``(first, count)`` of up to two runs of
@@ -778,7 +778,7 @@ def _bilinear(atlas: np.ndarray, a: int, b: int, c: int, d: int, fx: float, fy: 
     return (1 - fy) * top + fy * bottom
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def lit_colors(colors: np.ndarray, normals: np.ndarray, tris: np.ndarray, closed: np.ndarray,
                light: np.ndarray, ambient: float, diffuse: float, origin: np.ndarray,
                which: np.ndarray, lit: np.ndarray) -> None:
@@ -813,7 +813,7 @@ _SCALE_255 = np.float32(255.0)
 _HALF = np.float32(0.5)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def shade(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.ndarray,
           uvs: np.ndarray, atlas: np.ndarray, levels: np.ndarray, first_level: np.ndarray,
           texel_density: np.ndarray, tris: np.ndarray, normals: np.ndarray,

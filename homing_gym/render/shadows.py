@@ -49,7 +49,7 @@ def light_axes(direction) -> np.ndarray:
     return np.stack([u, np.cross(l, u), l])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def _rasterise(projected: np.ndarray, origin: np.ndarray, cell: float,
                depth: np.ndarray) -> None:
     """Keep per cell the greatest depth of the triangles ``projected (N, 3, 3)`` (map
@@ -91,7 +91,7 @@ def shadow_map(triangles: np.ndarray, direction) -> ShadowMap:
     return ShadowMap(depth, axes, low, cell)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def in_shadow(depth: np.ndarray, axes: np.ndarray, origin: np.ndarray, cell: float,
               x: float, y: float, z: float, facing: float) -> bool:
     """Whether the point ``(x, y, z)`` lies in the shadow of the map (see the module);

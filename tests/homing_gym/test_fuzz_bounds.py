@@ -87,7 +87,7 @@ def test_the_largest_route_is_followed_target_by_target():
     for k in range(3):
         assert np.array_equal(obs["goal"], inner.render_panorama(inner.goal_pose))
         inner.advance_goal()
-        obs = inner._observation()
+        obs = inner.observation()
         assert inner.goal_index == k + 1
     env.close()
 

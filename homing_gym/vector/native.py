@@ -1,0 +1,166 @@
+"""The native vector env: N robots in one process, behind Gymnasium 1.x's ``VectorEnv``.
+
+>>> envs = gym.make_vec("homing_gym/LocalHoming-v0", num_envs=8,
+...                     vectorization_mode="vector_entry_point")
+>>> obs, infos = envs.reset(seed=0)          # env i: exactly gym.make(...).reset(seed=i)
+>>> obs, rewards, terminated, truncated, infos = envs.step(envs.action_space.sample())
+
+Every registered id has this vector entry point. The envs step as in
+:class:`~homing_gym.vector.batch.EnvBatch` (physics in turn, panoramas rendered in
+threads); observations come batched (each key ``(N, ...)``), infos as Gymnasium's
+dict of arrays with ``_key`` masks. Episodes end after ``max_episode_steps`` (the id's,
+as ``gym.make`` would wrap it) with ``truncated``. ``autoreset_mode`` is Gymnasium's:
+``NEXT_STEP`` (the default: the step after an episode's end resets that env and
+ignores its action), ``SAME_STEP`` (reset at once; ``infos["final_obs"]`` and
+``infos["final_info"]``) or ``DISABLED`` (the caller resets with
+``options={"reset_mask": mask}``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from functools import partial
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+from gymnasium.vector import AutoresetMode
+from gymnasium.vector.utils import batch_space
+
+from homing_gym.env import HomingEnv, check_env_kwargs
+from homing_gym.vector.batch import MAX_NUM_ENVS, EnvBatch, checked_count, cores, episode_limit
+from homing_gym.vector.batch import autoreset_mode as autoreset_mode_of
+from homing_gym.vector.processes import ProcessBatch
+
+
+def _env_class(env_id: str) -> type[HomingEnv]:
+    spec = gym.spec(env_id)
+    entry = spec.entry_point
+    cls = gym.envs.registration.load_env_creator(entry) if isinstance(entry, str) else entry
+    if not (isinstance(cls, type) and issubclass(cls, HomingEnv)):
+        raise ValueError(f"{env_id!r} is not a homing_gym env (its entry point is {entry!r})")
+    return cls
+
+
+def make_env(cls: type[HomingEnv], kwargs: dict[str, Any]) -> HomingEnv:
+    """``cls(**kwargs)``, unknown keyword arguments refused by name (top-level, so that
+    worker processes can unpickle it)."""
+    check_env_kwargs(cls, kwargs)
+    return cls(**kwargs)
+
+
+class NativeVectorEnv(gym.vector.VectorEnv):
+    """``num_envs`` envs of ``env_id``. ``kwargs`` go to every env; ``env_kwargs``, a list
+    of ``num_envs`` dicts, adds each env's own (e.g. a scene per env), as long as all envs
+    keep one observation and action space (else ``ValueError``). ``processes``: 1 (the
+    default) steps every env in this process; ``K > 1`` spreads them over ``K`` worker
+    processes (:class:`~homing_gym.vector.processes.ProcessBatch`). ``threads``: render
+    threads per process (default: the cores over the processes)."""
+
+    def __init__(self, env_id: str, num_envs: int = 1, *,
+                 max_episode_steps: int | None = None,
+                 autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
+                 processes: int = 1, threads: int | None = None,
+                 env_kwargs: Sequence[dict] | None = None, **kwargs):
+        self.num_envs = checked_count("num_envs", num_envs, MAX_NUM_ENVS)
+        processes = checked_count("processes", processes, self.num_envs)
+        mode = autoreset_mode_of(autoreset_mode)
+        limit = episode_limit(gym.spec(env_id).max_episode_steps if max_episode_steps is None
+                              else max_episode_steps)
+        if env_kwargs is None:
+            env_kwargs = [{}] * self.num_envs
+        if (not isinstance(env_kwargs, Sequence) or len(env_kwargs) != self.num_envs
+                or not all(isinstance(k, dict) for k in env_kwargs)):
+            raise ValueError(f"env_kwargs must be a list of {self.num_envs} dicts (one per "
+                             f"env), got {env_kwargs!r}")
+        cls = _env_class(env_id)
+        makers = [partial(make_env, cls, {**kwargs, **own}) for own in env_kwargs]
+        if threads is None:
+            threads = max(1, cores() // processes)
+        self.batch = (EnvBatch(makers, threads=threads, max_episode_steps=limit, mode=mode)
+                      if processes == 1 else
+                      ProcessBatch(makers, processes, threads=threads,
+                                   max_episode_steps=limit, mode=mode))
+        self.max_episode_steps = limit
+        self.metadata = {**cls.metadata, "autoreset_mode": mode}
+        self.autoreset_mode = mode
+        self.render_mode = kwargs.get("render_mode")
+        self.single_observation_space = self.batch.observation_space
+        self.single_action_space = self.batch.action_space
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+
+    # -- Gymnasium API --------------------------------------------------------------------
+    def reset(self, *, seed: int | Sequence[int | None] | None = None,
+              options: dict[str, Any] | None = None):
+        """Reset every env (env ``i`` with ``seed + i``, or ``seed[i]``), or with
+        ``options={"reset_mask": mask}`` those where ``mask`` is true."""
+        self._check_open()
+        seeds = self._seeds(seed)
+        options = dict(options or {})
+        mask = options.pop("reset_mask", None)
+        if mask is not None and not (isinstance(mask, np.ndarray) and mask.dtype == np.bool_
+                                     and mask.shape == (self.num_envs,) and mask.any()):
+            raise ValueError(f"options['reset_mask'] must be a bool array of shape "
+                             f"({self.num_envs},) with at least one True, got {mask!r}")
+        infos: dict[str, Any] = {}
+        for i, info in enumerate(self.batch.reset(seeds, options or None, mask)):
+            if info is not None:
+                infos = self._add_info(infos, info, i)
+        return self.batch.stacked_obs(), infos
+
+    def step(self, actions):
+        self._check_open()
+        results = self.batch.step(self._checked_actions(actions))
+        infos: dict[str, Any] = {}
+        for i, info in enumerate(results.infos):
+            infos = self._add_info(infos, info, i)
+        return (self.batch.stacked_obs(), results.rewards, results.terminated,
+                results.truncated, infos)
+
+    def render(self) -> tuple[Any, ...] | None:
+        """Each env's :meth:`~homing_gym.env.HomingEnv.render` (``rgb_array`` pictures;
+        envs in this process only)."""
+        self._check_open()
+        if isinstance(self.batch, ProcessBatch):
+            raise ValueError("render() needs the envs in this process (processes=1)")
+        return tuple(env.render() for env in self.batch.envs)
+
+    def close_extras(self, **kwargs) -> None:
+        self.batch.close()
+
+    # -- helpers --------------------------------------------------------------------------
+    def _seeds(self, seed) -> list[int | None]:
+        if seed is None:
+            return [None] * self.num_envs
+        if isinstance(seed, (int, np.integer)) and not isinstance(seed, (bool, np.bool_)):
+            return [int(seed) + i for i in range(self.num_envs)]
+        if (isinstance(seed, Sequence) and not isinstance(seed, str)
+                and len(seed) == self.num_envs):
+            return list(seed)
+        raise ValueError(f"seed must be None, an integer (env i gets seed + i) or a list of "
+                         f"{self.num_envs} seeds, got {seed!r}")
+
+    def _checked_actions(self, actions) -> np.ndarray:
+        """``actions`` as an array of one action per env; ``ValueError`` naming the envs
+        whose actions are not finite or not valid."""
+        single = self.single_action_space
+        a = np.asarray(actions)
+        want = (self.num_envs, *single.shape)
+        if a.shape != want or a.dtype.kind not in "iuf":
+            raise ValueError(f"actions must be real numbers of shape {want} (one "
+                             f"{single} action per env), got shape {a.shape}, dtype {a.dtype}")
+        if isinstance(single, spaces.Discrete):
+            bad = np.flatnonzero(~np.isin(a, np.arange(single.start, single.start + single.n)))
+        else:
+            bad = np.flatnonzero(~np.isfinite(a.reshape(self.num_envs, -1)).all(axis=1))
+        if bad.size:
+            raise ValueError(f"the actions of envs {bad.tolist()} are not valid "
+                             f"{single} actions: {a[bad].tolist()}")
+        return a.astype(single.dtype, copy=False)
+
+    def _check_open(self) -> None:
+        if self.closed or self.batch.closed:
+            raise gym.error.ClosedEnvironmentError(
+                "this vector env was closed (its envs are gone); make a new one")

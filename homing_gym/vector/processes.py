@@ -1,0 +1,201 @@
+"""A batch of envs spread over worker processes, for machines with more cores than one
+process can use (PyBullet keeps the GIL: a process steps its robots on one core).
+
+:class:`ProcessBatch` has :class:`~homing_gym.vector.batch.EnvBatch`'s interface.
+Each of its ``processes`` spawned workers holds an :class:`EnvBatch` of a contiguous
+share of the envs and answers a whole vector step with one message; the observations
+go through shared memory (one block per worker and key), not the pipe. Env ``i``
+behaves as in one process (same seeds, same automatic resets), so results do not depend
+on the split. A worker whose env fails reports the env's index and error once; a worker
+that dies is reported with its envs; either way every worker is stopped and the shared
+memory freed. Workers ignore Ctrl-C (the main process closes them) and end when the
+main process does (their pipe closes).
+"""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import signal
+from collections.abc import Callable, Sequence
+from multiprocessing import shared_memory
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+from gymnasium.vector import AutoresetMode
+
+from homing_gym.env import HomingEnv
+from homing_gym.vector.batch import EnvBatch, EnvFailedError, StepResults
+
+#: Seconds a closing worker may take before it is killed.
+CLOSE_TIMEOUT = 10.0
+
+
+def _attached(names: dict[str, str], space: spaces.Dict, n: int
+              ) -> tuple[list[shared_memory.SharedMemory], dict[str, np.ndarray]]:
+    """The shared blocks ``names[key]`` (keep them while the views live) and views
+    ``(n, ...)`` of each key's."""
+    blocks = [shared_memory.SharedMemory(name=names[key]) for key in space.spaces]
+    views = {key: np.ndarray((n, *space[key].shape), space[key].dtype, buffer=block.buf)
+             for key, block in zip(space.spaces, blocks)}
+    return blocks, views
+
+
+def _serve(conn, makers: list[Callable[[], HomingEnv]], first: int, threads: int,
+           max_episode_steps: int | None, mode: AutoresetMode) -> None:
+    """A worker: build the batch, then answer commands until ``close`` or a closed pipe."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        batch = EnvBatch(makers, threads=threads, max_episode_steps=max_episode_steps,
+                         mode=mode, first_index=first)
+    except Exception as err:      # e.g. envs that cannot be batched: said in the main process
+        conn.send(("error", (type(err).__name__, str(err))))
+        return
+    conn.send(("ready", (batch.observation_space, batch.action_space)))
+    blocks, views = _attached(conn.recv(), batch.observation_space, batch.num_envs)
+
+    def write() -> None:
+        for key, view in views.items():
+            for i, obs in enumerate(batch.obs):
+                view[i] = obs[key]
+
+    try:
+        while True:
+            try:
+                command, data = conn.recv()
+            except EOFError:
+                break
+            try:
+                if command == "reset":
+                    answer = batch.reset(*data)
+                elif command == "step":
+                    r = batch.step(data)
+                    answer = (r.rewards, r.terminated, r.truncated, r.infos)
+                else:
+                    break
+                write()
+                conn.send(("ok", answer))
+            except EnvFailedError as err:
+                conn.send(("failed", (err.index, err.error)))
+                break
+            except ValueError as err:          # a bad seed or option: the batch lives on
+                conn.send(("error", ("ValueError", str(err))))
+    finally:
+        batch.close()
+        for block in blocks:
+            block.close()
+        conn.close()
+
+
+class ProcessBatch:
+    """The envs made by ``makers`` in ``processes`` spawned workers (contiguous shares),
+    each rendering with ``threads`` threads; as :class:`EnvBatch` otherwise."""
+
+    def __init__(self, makers: Sequence[Callable[[], HomingEnv]], processes: int, *,
+                 threads: int = 1, max_episode_steps: int | None = None,
+                 mode: AutoresetMode = AutoresetMode.NEXT_STEP):
+        self.num_envs = len(makers)
+        bounds = np.linspace(0, self.num_envs, processes + 1).round().astype(int)
+        #: ``(first, stop)`` env indices of each worker's share.
+        self.shares = [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
+        ctx = mp.get_context("spawn")
+        self._conns, self._processes, self._blocks = [], [], []
+        self._views: list[dict[str, np.ndarray]] = []
+        self.closed = False
+        self.started = False
+        try:
+            for first, stop in self.shares:
+                parent, child = ctx.Pipe()
+                process = ctx.Process(target=_serve, daemon=True, name=f"homing-env-{first}",
+                                      args=(child, list(makers[first:stop]), first, threads,
+                                            max_episode_steps, mode))
+                process.start()
+                child.close()
+                self._conns.append(parent)
+                self._processes.append(process)
+            spaces_of = [self._answer(w) for w in range(len(self.shares))]
+            self.observation_space, self.action_space = spaces_of[0]
+            for w, (obs_space, act_space) in enumerate(spaces_of[1:], 1):
+                if (obs_space, act_space) != spaces_of[0]:
+                    raise ValueError(f"env {self.shares[w][0]} cannot be batched with env 0: "
+                                     f"its spaces {obs_space}, {act_space} differ from "
+                                     f"{spaces_of[0]}")
+            for conn, (first, stop) in zip(self._conns, self.shares):
+                views = {}
+                for key, space in self.observation_space.spaces.items():
+                    shape = (stop - first, *space.shape)
+                    block = shared_memory.SharedMemory(
+                        create=True, size=max(1, int(np.prod(shape)) * space.dtype.itemsize))
+                    self._blocks.append(block)
+                    views[key] = np.ndarray(shape, space.dtype, buffer=block.buf)
+                conn.send({key: block.name for key, block in
+                           zip(views, self._blocks[-len(views):])})
+                self._views.append(views)
+        except BaseException:
+            self.close()
+            raise
+
+    def stacked_obs(self) -> dict[str, np.ndarray]:
+        """The latest observations as one batch (each key ``(N, ...)``)."""
+        return {key: np.concatenate([views[key] for views in self._views])
+                for key in self.observation_space.spaces}
+
+    def _answer(self, w: int) -> Any:
+        """Worker ``w``'s answer; its env's failure, or its death, closes everything."""
+        first, stop = self.shares[w]
+        try:
+            status, data = self._conns[w].recv()
+        except (EOFError, ConnectionResetError, OSError):
+            process = self._processes[w]
+            process.join(1.0)
+            self.close()
+            raise EnvFailedError(first, f"its worker process (envs {first}-{stop - 1}) "
+                                        f"died with exit code {process.exitcode}") from None
+        if status == "failed":
+            self.close()
+            raise EnvFailedError(*data)
+        if status == "error":
+            kind, message = data
+            if kind != "ValueError":
+                self.close()
+            raise (ValueError if kind == "ValueError" else RuntimeError)(message)
+        return data
+
+    def reset(self, seeds: Sequence[int | None], options: dict | None = None,
+              mask: np.ndarray | None = None) -> list[dict[str, Any] | None]:
+        for conn, (first, stop) in zip(self._conns, self.shares):
+            conn.send(("reset", (list(seeds[first:stop]), options,
+                                 None if mask is None else mask[first:stop])))
+        answers = [self._answer(w) for w in range(len(self.shares))]
+        self.started = True
+        return [info for infos in answers for info in infos]
+
+    def step(self, actions: Sequence[Any]) -> StepResults:
+        for conn, (first, stop) in zip(self._conns, self.shares):
+            conn.send(("step", actions[first:stop]))
+        answers = [self._answer(w) for w in range(len(self.shares))]
+        rewards, terminated, truncated, infos = zip(*answers)
+        return StepResults(np.concatenate(rewards), np.concatenate(terminated),
+                           np.concatenate(truncated), [i for part in infos for i in part])
+
+    def close(self) -> None:
+        """Stop every worker and free the shared memory; safe to call more than once."""
+        if self.closed:
+            return
+        self.closed = True
+        for conn in self._conns:
+            try:
+                conn.send(("close", None))
+            except (BrokenPipeError, ConnectionResetError, OSError):
+                pass
+        for process in self._processes:
+            process.join(CLOSE_TIMEOUT)
+            if process.is_alive():
+                process.kill()
+                process.join()
+        for conn in self._conns:
+            conn.close()
+        self._views = []
+        for block in self._blocks:
+            block.close()
+            block.unlink()
