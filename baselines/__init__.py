@@ -17,7 +17,10 @@ from homing_baselines.motion import MotionHelper, MotionSpec, Move
 from homing_baselines.bearing import (BasicBearingController, BearingController,
                                ComplementaryBearingController)
 from homing_baselines.bearing_longrange import LongRangeBearingController
+from homing_baselines.alv import ALVController
+from homing_baselines.did import DIDController
 from homing_baselines.distance import DistanceController
+from homing_baselines.min_warping import MinWarpingController
 from homing_baselines.multires import MultiResController
 from homing_baselines.oracle import OracleController
 from homing_baselines.random_walk import RandomController
@@ -75,6 +78,9 @@ register("bearing-complementary", ComplementaryBearingController)
 register("bearing-longrange", LongRangeBearingController)
 register("selfsimilar", SelfSimilarController)
 register("multires", MultiResController)
+register("alv", ALVController)
+register("did", DIDController)
+register("min-warping", MinWarpingController)
 
 __all__ = ["Controller", "MotionHelper", "MotionSpec", "Move", "OracleController",
            "RandomController", "available", "controller_class", "make", "parameters",

@@ -17,11 +17,12 @@ _HEX = {"black": "000000", "orange": "E69F00", "sky": "56B4E9", "green": "009E73
         "blue": "0072B2", "vermillion": "D55E00", "purple": "CC79A7", "grey": "999999",
         "indigo": "332288", "teal": "44AA99", "olive": "999933", "wine": "882255",
         "rose": "CC6677", "sand": "DDCC77", "brown": "8C510A", "forest": "1B7837",
-        "plum": "762A83"}
+        "plum": "762A83", "cyan": "88CCEE", "tol-green": "117733", "tol-purple": "AA4499"}
 _FIXED = {"oracle": "black", "random": "grey", "snapshot": "orange", "warping": "sky",
           "distance": "blue", "bearing": "purple", "bearing-basic": "rose",
           "bearing-complementary": "wine", "bearing-longrange": "indigo",
           "selfsimilar": "olive", "multires": "teal",
+          "alv": "tol-purple", "did": "cyan", "min-warping": "tol-green",
           # the shipped learned policies (train/shipped/)
           "ppo_procedural_long": "plum", "ppo_procedural_imitation": "green"}
 _SPARE = ("vermillion", "sand", "brown", "forest")
