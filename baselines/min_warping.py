@@ -49,8 +49,9 @@ Our choices (where the papers leave room):
   magnified column samples the original at ``atan(tan(e) / sigma)`` (linear
   interpolation, edge rows repeated). Column distance: sum of squared differences.
 * Stop: the matched columns at the best ``(alpha, psi)`` give per-column displacement
-  ratios ``d / r_i = |sin(v - u) / sin(v)|``; their median is a distance estimate in units
-  of landmark distance (as Franz's ``rho``); the robot stops when it is ``<= rho_stop``
+  ratios ``d / r_i = |sin(v - u) / sin(v)|``; their median over the informative columns
+  (those whose allowed matches do not all cost the same: a uniform wall column ties, and
+  a tie would read as "not moved") is a distance estimate in units of landmark distance (as Franz's ``rho``); the robot stops when it is ``<= rho_stop``
   (as :mod:`homing_baselines.warping` stops at ``rho = 0``), or after ``max_steps``.
 * The search is a numba kernel over ``alpha x psi x (allowed u, v pairs)``: about
   ``n^4 / 4`` table look-ups (4.2 million for 64 columns).
@@ -252,9 +253,14 @@ def min_warp(snapshot: np.ndarray, current: np.ndarray,
     sv = np.sin(v_s * step)
     safe = np.abs(sv) > 1e-9
     ratios = np.where(safe, np.abs(np.sin((v_s - us) * step)) / np.where(safe, np.abs(sv), 1), 0.0)
+    # columns whose allowed matches all cost the same (a uniform wall or sky) say nothing
+    # about the displacement: their tie would read as "not moved"
+    spread = np.maximum.reduceat(vals, start[:-1]) - group_min
+    informative = spread > 1e-6 * max(1.0, float(np.abs(vals).max()))
+    rho = float(np.median(ratios[informative])) if informative.any() else 0.0
     return MinWarpResult(alpha=wrap_angle(alpha), psi=wrap_angle(psi),
                          home_direction=wrap_angle(alpha + np.pi - psi),
-                         rho=float(np.median(ratios)), cost=float(E[a, p]), costs=E)
+                         rho=rho, cost=float(E[a, p]), costs=E)
 
 
 @dataclass
