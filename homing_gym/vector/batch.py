@@ -203,6 +203,22 @@ class EnvBatch:
         self._autoreset = terminated | truncated
         return StepResults(rewards, terminated, truncated, infos)
 
+    def call(self, name: str, args: tuple = (), kwargs: dict | None = None,
+             indices: Sequence[int] | None = None) -> list[Any]:
+        """For each env of ``indices`` (default: all), its attribute ``name``, called with
+        ``args`` and ``kwargs`` if it is a method."""
+        values = []
+        for i in range(self.num_envs) if indices is None else indices:
+            value = getattr(self.envs[i], name)
+            values.append(value(*args, **(kwargs or {})) if callable(value) else value)
+        return values
+
+    def set_attr(self, name: str, values: Sequence[Any],
+                 indices: Sequence[int] | None = None) -> None:
+        """Set attribute ``name`` of each env of ``indices`` (default: all) to its value."""
+        for i, value in zip(range(self.num_envs) if indices is None else indices, values):
+            setattr(self.envs[i], name, value)
+
     def _failed(self, index: int, error: BaseException) -> EnvFailedError:
         failed = EnvFailedError(self._first + index, f"{type(error).__name__}: {error}")
         self.close()

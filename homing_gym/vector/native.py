@@ -18,7 +18,7 @@ ignores its action), ``SAME_STEP`` (reset at once; ``infos["final_obs"]`` and
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from functools import partial
 from typing import Any
 
@@ -34,20 +34,28 @@ from homing_gym.vector.batch import autoreset_mode as autoreset_mode_of
 from homing_gym.vector.processes import ProcessBatch
 
 
-def _env_class(env_id: str) -> type[HomingEnv]:
-    spec = gym.spec(env_id)
-    entry = spec.entry_point
-    cls = gym.envs.registration.load_env_creator(entry) if isinstance(entry, str) else entry
-    if not (isinstance(cls, type) and issubclass(cls, HomingEnv)):
-        raise ValueError(f"{env_id!r} is not a homing_gym env (its entry point is {entry!r})")
-    return cls
+def _creator(env_id: str) -> Callable[..., Any]:
+    """What ``gym.make(env_id)`` calls to make the env (its entry point, loaded)."""
+    entry = gym.spec(env_id).entry_point
+    return gym.envs.registration.load_env_creator(entry) if isinstance(entry, str) else entry
 
 
-def make_env(cls: type[HomingEnv], kwargs: dict[str, Any]) -> HomingEnv:
-    """``cls(**kwargs)``, unknown keyword arguments refused by name (top-level, so that
-    worker processes can unpickle it)."""
-    check_env_kwargs(cls, kwargs)
-    return cls(**kwargs)
+def make_env(env_id: str, kwargs: dict[str, Any]) -> HomingEnv:
+    """The bare env of ``env_id`` made with ``kwargs`` (the spec's own kwargs first), as
+    ``gym.make`` would make it before its wrappers; ``ValueError`` when that is not a
+    :class:`~homing_gym.env.HomingEnv` (top-level, so that worker processes can unpickle
+    it)."""
+    creator = _creator(env_id)
+    if isinstance(creator, type) and issubclass(creator, HomingEnv):
+        check_env_kwargs(creator, kwargs)
+    env = creator(**{**gym.spec(env_id).kwargs, **kwargs})
+    if not isinstance(env, HomingEnv):
+        if hasattr(env, "close"):
+            env.close()
+        raise ValueError(f"{env_id!r} makes a {type(env).__name__}, not a homing_gym env: "
+                         f"the native vector env steps HomingEnv instances directly (use "
+                         f"vectorization_mode='sync' or 'async' for other envs)")
+    return env
 
 
 class NativeVectorEnv(gym.vector.VectorEnv):
@@ -66,16 +74,23 @@ class NativeVectorEnv(gym.vector.VectorEnv):
         self.num_envs = checked_count("num_envs", num_envs, MAX_NUM_ENVS)
         processes = checked_count("processes", processes, self.num_envs)
         mode = autoreset_mode_of(autoreset_mode)
-        limit = episode_limit(gym.spec(env_id).max_episode_steps if max_episode_steps is None
-                              else max_episode_steps)
         if env_kwargs is None:
             env_kwargs = [{}] * self.num_envs
         if (not isinstance(env_kwargs, Sequence) or len(env_kwargs) != self.num_envs
                 or not all(isinstance(k, dict) for k in env_kwargs)):
             raise ValueError(f"env_kwargs must be a list of {self.num_envs} dicts (one per "
                              f"env), got {env_kwargs!r}")
-        cls = _env_class(env_id)
-        makers = [partial(make_env, cls, {**kwargs, **own}) for own in env_kwargs]
+        settings = [{**kwargs, **own} for own in env_kwargs]
+        limits = [own.pop("max_episode_steps") for own in settings if "max_episode_steps" in own]
+        if limits and (len(limits) < len(settings) or any(k != limits[0] for k in limits)):
+            raise ValueError(f"the envs' max_episode_steps differ ({limits}, given for "
+                             f"{len(limits)} of {len(settings)} envs): one vector env has "
+                             f"one step limit")
+        if limits:
+            max_episode_steps = limits[0]
+        makers = [partial(make_env, env_id, own) for own in settings]
+        limit = episode_limit(gym.spec(env_id).max_episode_steps if max_episode_steps is None
+                              else max_episode_steps)
         if threads is None:
             threads = max(1, cores() // processes)
         self.batch = (EnvBatch(makers, threads=threads, max_episode_steps=limit, mode=mode)
@@ -83,7 +98,7 @@ class NativeVectorEnv(gym.vector.VectorEnv):
                       ProcessBatch(makers, processes, threads=threads,
                                    max_episode_steps=limit, mode=mode))
         self.max_episode_steps = limit
-        self.metadata = {**cls.metadata, "autoreset_mode": mode}
+        self.metadata = {**getattr(_creator(env_id), "metadata", {}), "autoreset_mode": mode}
         self.autoreset_mode = mode
         self.render_mode = kwargs.get("render_mode")
         self.single_observation_space = self.batch.observation_space
@@ -112,7 +127,7 @@ class NativeVectorEnv(gym.vector.VectorEnv):
 
     def step(self, actions):
         self._check_open()
-        results = self.batch.step(self._checked_actions(actions))
+        results = self.batch.step(self.checked_actions(actions))
         infos: dict[str, Any] = {}
         for i, info in enumerate(results.infos):
             infos = self._add_info(infos, info, i)
@@ -127,10 +142,41 @@ class NativeVectorEnv(gym.vector.VectorEnv):
             raise ValueError("render() needs the envs in this process (processes=1)")
         return tuple(env.render() for env in self.batch.envs)
 
+    def call(self, name: str, *args, **kwargs) -> tuple[Any, ...]:
+        """Each env's attribute ``name`` (called with ``args`` and ``kwargs`` if a method),
+        as Gymnasium's ``SyncVectorEnv.call``."""
+        self._check_open()
+        return tuple(self.batch.call(name, args, kwargs))
+
+    def get_attr(self, name: str) -> tuple[Any, ...]:
+        """Each env's attribute ``name``."""
+        return self.call(name)
+
+    def set_attr(self, name: str, values: Any | Sequence[Any]) -> None:
+        """Set each env's attribute ``name``: to ``values[i]`` given a list of
+        ``num_envs`` values, else to ``values``."""
+        self._check_open()
+        if not (isinstance(values, (list, tuple)) and len(values) == self.num_envs):
+            values = [values] * self.num_envs
+        self.batch.set_attr(name, values)
+
     def close_extras(self, **kwargs) -> None:
         self.batch.close()
 
     # -- helpers --------------------------------------------------------------------------
+    def _add_info(self, vector_infos: dict[str, Any], env_info: dict[str, Any],
+                  env_num: int) -> dict[str, Any]:
+        """Gymnasium's layout of infos, where an array whose shape differs between envs
+        (a route's waypoints) is kept per env in an object array."""
+        for key, value in env_info.items():
+            have = vector_infos.get(key)
+            if (isinstance(value, np.ndarray) and isinstance(have, np.ndarray)
+                    and have.dtype != object and have.shape[1:] != value.shape):
+                ragged = np.empty(self.num_envs, object)
+                ragged[:] = list(have)
+                vector_infos[key] = ragged
+        return super()._add_info(vector_infos, env_info, env_num)
+
     def _seeds(self, seed) -> list[int | None]:
         if seed is None:
             return [None] * self.num_envs
@@ -142,7 +188,7 @@ class NativeVectorEnv(gym.vector.VectorEnv):
         raise ValueError(f"seed must be None, an integer (env i gets seed + i) or a list of "
                          f"{self.num_envs} seeds, got {seed!r}")
 
-    def _checked_actions(self, actions) -> np.ndarray:
+    def checked_actions(self, actions) -> np.ndarray:
         """``actions`` as an array of one action per env; ``ValueError`` naming the envs
         whose actions are not finite or not valid."""
         single = self.single_action_space

@@ -29,6 +29,10 @@ from homing_gym.vector.batch import EnvBatch, EnvFailedError, StepResults
 
 #: Seconds a closing worker may take before it is killed.
 CLOSE_TIMEOUT = 10.0
+#: Errors a worker reports as themselves (bad seeds or options, unknown attributes);
+#: others come as ``RuntimeError`` naming their type.
+_CALLER_ERRORS = {"ValueError": ValueError, "AttributeError": AttributeError,
+                  "TypeError": TypeError}
 
 
 def _attached(names: dict[str, str], space: spaces.Dict, n: int
@@ -61,25 +65,28 @@ def _serve(conn, makers: list[Callable[[], HomingEnv]], first: int, threads: int
 
     try:
         while True:
-            try:
-                command, data = conn.recv()
-            except EOFError:
-                break
+            command, data = conn.recv()
             try:
                 if command == "reset":
                     answer = batch.reset(*data)
                 elif command == "step":
                     r = batch.step(data)
                     answer = (r.rewards, r.terminated, r.truncated, r.infos)
+                elif command in ("call", "set_attr"):
+                    answer = getattr(batch, command)(*data)
                 else:
                     break
-                write()
-                conn.send(("ok", answer))
             except EnvFailedError as err:
                 conn.send(("failed", (err.index, err.error)))
                 break
-            except ValueError as err:          # a bad seed or option: the batch lives on
-                conn.send(("error", ("ValueError", str(err))))
+            except Exception as err:    # noqa: BLE001  a bad seed, an unknown attribute, a
+                conn.send(("error", (type(err).__name__, str(err))))    # step before reset
+                continue
+            if command in ("reset", "step"):
+                write()
+            conn.send(("ok", answer))
+    except (EOFError, OSError):         # the main process is gone
+        pass
     finally:
         batch.close()
         for block in blocks:
@@ -113,7 +120,7 @@ class ProcessBatch:
                 child.close()
                 self._conns.append(parent)
                 self._processes.append(process)
-            spaces_of = [self._answer(w) for w in range(len(self.shares))]
+            spaces_of = self._answers(range(len(self.shares)))
             self.observation_space, self.action_space = spaces_of[0]
             for w, (obs_space, act_space) in enumerate(spaces_of[1:], 1):
                 if (obs_space, act_space) != spaces_of[0]:
@@ -140,43 +147,86 @@ class ProcessBatch:
         return {key: np.concatenate([views[key] for views in self._views])
                 for key in self.observation_space.spaces}
 
-    def _answer(self, w: int) -> Any:
-        """Worker ``w``'s answer; its env's failure, or its death, closes everything."""
-        first, stop = self.shares[w]
+    def _send(self, w: int, message: tuple) -> None:
+        """Send ``message`` to worker ``w``; a dead worker's pipe is said by
+        :meth:`_answers`."""
         try:
-            status, data = self._conns[w].recv()
-        except (EOFError, ConnectionResetError, OSError):
-            process = self._processes[w]
-            process.join(1.0)
+            self._conns[w].send(message)
+        except OSError:
+            pass
+
+    def _answers(self, workers: Sequence[int]) -> list[Any]:
+        """The answers of ``workers``, each read before any error is raised (so that no
+        answer is left in a pipe): an env's failure, or a worker's death, closes
+        everything; a caller's error (a bad seed, an unknown attribute) leaves the envs."""
+        answers, error = [], None
+        for w in workers:
+            first, stop = self.shares[w]
+            try:
+                status, data = self._conns[w].recv()
+            except (EOFError, ConnectionResetError, OSError):
+                self._processes[w].join(1.0)
+                status, data = "failed", (first, f"its worker process (envs {first}-{stop - 1})"
+                                                 f" died with exit code "
+                                                 f"{self._processes[w].exitcode}")
+            if status == "failed":
+                error = error or EnvFailedError(*data)
+            elif status == "error":
+                kind, message = data
+                error = error or _CALLER_ERRORS.get(kind, RuntimeError)(
+                    message if kind in _CALLER_ERRORS else f"{kind}: {message}")
+            answers.append(data)
+        if isinstance(error, EnvFailedError):
             self.close()
-            raise EnvFailedError(first, f"its worker process (envs {first}-{stop - 1}) "
-                                        f"died with exit code {process.exitcode}") from None
-        if status == "failed":
-            self.close()
-            raise EnvFailedError(*data)
-        if status == "error":
-            kind, message = data
-            if kind != "ValueError":
-                self.close()
-            raise (ValueError if kind == "ValueError" else RuntimeError)(message)
-        return data
+        if error is not None:
+            raise error
+        return answers
 
     def reset(self, seeds: Sequence[int | None], options: dict | None = None,
               mask: np.ndarray | None = None) -> list[dict[str, Any] | None]:
-        for conn, (first, stop) in zip(self._conns, self.shares):
-            conn.send(("reset", (list(seeds[first:stop]), options,
-                                 None if mask is None else mask[first:stop])))
-        answers = [self._answer(w) for w in range(len(self.shares))]
+        for w, (first, stop) in enumerate(self.shares):
+            self._send(w, ("reset", (list(seeds[first:stop]), options,
+                                     None if mask is None else mask[first:stop])))
+        answers = self._answers(range(len(self.shares)))
         self.started = True
         return [info for infos in answers for info in infos]
 
     def step(self, actions: Sequence[Any]) -> StepResults:
-        for conn, (first, stop) in zip(self._conns, self.shares):
-            conn.send(("step", actions[first:stop]))
-        answers = [self._answer(w) for w in range(len(self.shares))]
+        for w, (first, stop) in enumerate(self.shares):
+            self._send(w, ("step", actions[first:stop]))
+        answers = self._answers(range(len(self.shares)))
         rewards, terminated, truncated, infos = zip(*answers)
         return StepResults(np.concatenate(rewards), np.concatenate(terminated),
                            np.concatenate(truncated), [i for part in infos for i in part])
+
+    def _per_worker(self, command: str, data_of: Callable[[list[int], list[int]], tuple],
+                    indices: Sequence[int] | None) -> list[Any]:
+        """Send ``command`` with ``data_of(local indices, positions)`` to each worker
+        holding envs of ``indices`` (default: all); the answers in the order of
+        ``indices``."""
+        indices = list(range(self.num_envs) if indices is None else indices)
+        asked = []
+        for w, (first, stop) in enumerate(self.shares):
+            positions = [k for k, i in enumerate(indices) if first <= i < stop]
+            if positions:
+                local = [indices[k] - first for k in positions]
+                self._send(w, (command, data_of(local, positions)))
+                asked.append((w, positions))
+        answers: list[Any] = [None] * len(indices)
+        for (_, positions), values in zip(asked, self._answers([w for w, _ in asked])):
+            for k, value in zip(positions, values or [None] * len(positions)):
+                answers[k] = value
+        return answers
+
+    def call(self, name: str, args: tuple = (), kwargs: dict | None = None,
+             indices: Sequence[int] | None = None) -> list[Any]:
+        return self._per_worker("call", lambda local, _: (name, args, kwargs, local), indices)
+
+    def set_attr(self, name: str, values: Sequence[Any],
+                 indices: Sequence[int] | None = None) -> None:
+        values = list(values)
+        self._per_worker("set_attr", lambda local, positions: (
+            name, [values[k] for k in positions], local), indices)
 
     def close(self) -> None:
         """Stop every worker and free the shared memory; safe to call more than once."""

@@ -121,7 +121,7 @@ class TrainConfig:
     timesteps: int = 300_000
     n_envs: int = 2
     vec: str = "subproc"
-    workers: int | None = None        # subprocesses for "subproc" (None: one per env)
+    workers: int | None = None        # processes: "subproc" (None: one per env), "native" (None: 1)
     device: str = "cpu"
     torch_threads: int = 1
     extractor: str = "panorama"
@@ -149,8 +149,8 @@ class TrainConfig:
         if not isinstance(self.env_id, str) or self.env_id not in gym.registry:
             raise ValueError(f"unknown env {self.env_id!r}; homing-gym ids: "
                              f"{list(homing_gym.ENV_IDS)} (or register yours, --import MODULE)")
-        if self.vec not in ("subproc", "dummy"):
-            raise ValueError(f"--vec must be 'subproc' or 'dummy', got {self.vec!r}")
+        if self.vec not in VECS:
+            raise ValueError(f"--vec must be one of {VECS}, got {self.vec!r}")
         if self.workers is not None and not (_integer(self.workers)
                                              and 1 <= self.workers <= self.n_envs):
             raise ValueError(f"workers must be an integer from 1 to n_envs ({self.n_envs}), "
@@ -354,11 +354,19 @@ def make_vec(config: TrainConfig, n_envs: int, seed: int, report_dir: Path | Non
     ``(i)``, seed ``seed + i``; success logged from ``is_success``), images transposed to
     channel-first; subprocess workers write their errors to ``report_dir``. With
     ``vec="subproc"``, one process per env, or ``config.workers`` processes each stepping
-    a group of envs (:class:`~homing_train.learning.grouped_vec_env.GroupedSubprocVecEnv`)."""
+    a group of envs (:class:`~homing_train.learning.grouped_vec_env.GroupedSubprocVecEnv`);
+    with ``vec="native"``, homing-gym's native vector env in this process or
+    ``config.workers`` processes (:mod:`homing_train.learning.native_vec_env`)."""
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecTransposeImage
 
     from homing_train.learning.grouped_vec_env import GroupedSubprocVecEnv
+    from homing_train.learning.native_vec_env import native_vec_env
 
+    if config.vec == "native":
+        env = native_vec_env(config.env_id, [config.env_kwargs_of(r) for r in range(n_envs)],
+                             processes=config.workers or 1)
+        env.seed(seed)
+        return VecTransposeImage(env)
     report = None if report_dir is None else str(report_dir)
     fns = [partial(make_monitored_env, config.env_id, config.env_kwargs_of(rank), report)
            for rank in range(n_envs)]
@@ -572,6 +580,8 @@ def check_curriculum(env: gym.Env, curriculum: CurriculumSettings) -> None:
             raise ValueError(f"curriculum stage {i}: {err}") from err
 
 
+#: How ``homing-train`` may run its envs (``--vec``).
+VECS = ("subproc", "dummy", "native")
 #: memory of one subprocess env worker (279 MiB unique to it, measured with a LocalHoming-v0
 #: env at 16x64: Python, torch, PyBullet and the world)
 WORKER_MEMORY = 300 * 2**20
@@ -583,8 +593,10 @@ def check_memory(config: TrainConfig, observation_space: gym.Space) -> None:
     Adam's two moments: 16 bytes a parameter) or its env worker processes
     (:data:`WORKER_MEMORY` each) need more than this machine's memory."""
     memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    processes = (min(config.workers or config.n_envs, config.n_envs)
-                 if config.vec == "subproc" and config.n_envs > 1 else 0)
+    processes = {"subproc": min(config.workers or config.n_envs, config.n_envs)
+                 if config.n_envs > 1 else 0,
+                 "native": config.workers if (config.workers or 1) > 1 else 0,
+                 "dummy": 0}[config.vec]
     n_steps = config.ppo.get("n_steps", 2048)
     values = gym.spaces.flatdim(observation_space)
     rollout = 4 * n_steps * config.n_envs * values
@@ -598,8 +610,9 @@ def check_memory(config: TrainConfig, observation_space: gym.Space) -> None:
             (16 * parameters, f"the policy's MLP (net_arch {arch} after features_dim "
                               f"{config.features_dim}: {parameters} parameters x 16 bytes)",
              "narrower layers"),
-            (processes * WORKER_MEMORY, f"{processes} env worker processes (--vec subproc, "
-                                        f"about {WORKER_MEMORY // 2**20} MiB each)",
+            (processes * WORKER_MEMORY, f"{processes} env worker processes (--vec "
+                                        f"{config.vec}, about {WORKER_MEMORY // 2**20} MiB "
+                                        f"each)",
              "fewer n_envs, or fewer workers (--hp workers=N steps the envs in N "
              "processes)")):
         if need > memory:
@@ -770,7 +783,7 @@ def _benchmark(parser, config: TrainConfig, steps: int) -> int:
     label = (f"{config.env_id.split('/')[-1]} {config.env_kwargs.get('scene', '')} {shape} "
              f"{sim['renderer']}, {config.extractor}, n_epochs {config.ppo.get('n_epochs')}, "
              f"batch {config.ppo.get('batch_size')}, {config.vec}"
-             + (f" in {config.workers} workers" if config.vec == "subproc" and config.workers
+             + (f" in {config.workers} workers" if config.vec != "dummy" and config.workers
                 else ""))
     torch.set_num_threads(config.torch_threads)
     try:
@@ -873,7 +886,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=seed_value)
     parser.add_argument("--timesteps", type=int)
     parser.add_argument("--n-envs", type=int)
-    parser.add_argument("--vec", choices=("subproc", "dummy"))
+    parser.add_argument("--vec", choices=VECS,
+                        help="how the envs run: 'subproc' (a process per env, or --workers "
+                             "processes each stepping a group), 'dummy' (in turn, in this "
+                             "process), 'native' (homing-gym's native vector env: this "
+                             "process, panoramas rendered in threads, or --workers processes)")
+    parser.add_argument("--workers", type=int,
+                        help="processes that step the envs (--vec subproc or native)")
     parser.add_argument("--device")
     parser.add_argument("--extractor", choices=EXTRACTORS)
     parser.add_argument("--no-progress", action="store_true")
@@ -907,7 +926,8 @@ def main(argv: list[str] | None = None) -> int:
                                  f"with --hp init_policy=ZIP, or start from scratch with --hp "
                                  f"init_policy=null")
             config = make_config(env_id, settings, seed=args.seed, timesteps=args.timesteps,
-                                 n_envs=args.n_envs, vec=args.vec, device=args.device,
+                                 n_envs=args.n_envs, vec=args.vec, workers=args.workers,
+                                 device=args.device,
                                  extractor=args.extractor, env_kwargs=args.env_kwargs)
             if args.benchmark is None:
                 run = Path(checked_output_dir(
