@@ -33,7 +33,7 @@ from __future__ import annotations
 import json
 import sys
 import time
-from dataclasses import dataclass, fields
+from dataclasses import asdict, dataclass, fields
 
 import gymnasium as gym
 import numpy as np
@@ -305,9 +305,22 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--resets", type=int, default=0, metavar="N",
                         help="also time N resets (x 5 blocks) in each procedural world, "
                              "with a new world every time and in the same world")
+    parser.add_argument("--vec", choices=["native"],
+                        help="measure the native vector env instead (homing_gym.vector."
+                             "benchmark): --num-envs envs in one process and in each of "
+                             "--processes, against one env in one process, at the first "
+                             "--shapes in each --worlds")
+    parser.add_argument("--num-envs", type=worker_count, default=8,
+                        help="envs of the native vector env (--vec native)")
+    parser.add_argument("--processes", type=worker_count, nargs="+", default=[2],
+                        help="worker process counts measured beside one process (--vec native)")
+    parser.add_argument("--episode-steps", type=worker_count, default=45,
+                        help="mean episode length of the random actions (--vec native)")
     args = parser.parse_args(argv)
     if args.steps < 10 or args.resets < 0:
         parser.error("need --steps >= 10 and --resets >= 0")
+    if args.vec == "native":
+        return _native(args, parser)
     try:
         measured = configs(args.renderers, args.shapes, args.worlds)
     except ValueError as err:
@@ -318,6 +331,25 @@ def main(argv: list[str] | None = None) -> int:
         print(reset_table(args.resets))
     if args.json:
         write_text_atomic(args.json, json.dumps([_record(r) for r in results], indent=2))
+    return 0
+
+
+def _native(args, parser) -> int:
+    """``--vec native``: the table of :mod:`homing_gym.vector.benchmark`."""
+    from homing_gym.vector import benchmark as vector_benchmark
+
+    if any(p > args.num_envs for p in args.processes):
+        parser.error(f"--processes {args.processes}: at most --num-envs ({args.num_envs})")
+    try:
+        worlds = {w: world_kwargs(w) for w in args.worlds}
+    except ValueError as err:
+        parser.error(f"--worlds: {err}")
+    results = vector_benchmark.run(worlds, args.num_envs, sorted({1, *args.processes}),
+                                   args.steps, episode_steps=args.episode_steps,
+                                   shape=SHAPES[args.shapes[0]])
+    print(vector_benchmark.table(results, args.num_envs))
+    if args.json:
+        write_text_atomic(args.json, json.dumps([asdict(r) for r in results], indent=2))
     return 0
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import dataclasses
 import inspect
 import math
-from typing import Any
+from typing import Any, Protocol
 
 import gymnasium as gym
 import numpy as np
@@ -26,6 +26,7 @@ from homing_gym.observations import (CORE_KEYS, PANORAMA_KEYS, ObservationKey, S
 from homing_gym.render.panorama import Lighting, PanoramaCamera, random_lighting
 from homing_gym.paths import occupancy
 from homing_gym.render.perspective import PerspectiveConfig, render_perspective
+from homing_gym.render.raycast import RayCaster
 from homing_gym.sim.robot import odometry_for
 from homing_gym.scenes import scene_factory
 from homing_gym.scenes.base import Scene, clearance
@@ -55,6 +56,31 @@ def _check_room(scene: Scene, radius: float) -> None:
         raise ValueError(f"scene {scene.name!r} has no free space for the robot (a disc of "
                          f"radius {radius} m) within its bounds {scene.bounds!r} at the "
                          f"robot's height ({scene.height_band[0]}-{scene.height_band[1]} m)")
+
+
+#: Spawn key that sets a seed's world stream apart from its episode stream.
+WORLD_STREAM = 0x776F726C64
+
+
+def world_seeds(rng: np.random.Generator) -> np.random.SeedSequence:
+    """The world stream of an episode generator seeded by ``reset(seed=...)``: world ``k``
+    of the unseeded resets that follow is built from its ``k``-th child, so the worlds
+    to come are known ahead (and can be built in the background) whatever the episodes
+    draw."""
+    parent = rng.bit_generator.seed_seq
+    return np.random.SeedSequence(parent.entropy, spawn_key=(*parent.spawn_key, WORLD_STREAM),
+                                  pool_size=parent.pool_size)
+
+
+class WorldSource(Protocol):
+    """Builds a procedural scene's worlds ahead of need (:mod:`homing_gym.vector.worlds`)."""
+
+    def world(self, seeds: np.random.SeedSequence) -> tuple[Scene, RayCaster | None] | None:
+        """The world built from ``seeds`` (and its ray caster), or ``None`` to build it
+        here."""
+
+    def ahead(self, stream: np.random.SeedSequence) -> None:
+        """Start building the next world of ``stream`` (its next child)."""
 
 
 def check_env_kwargs(env_class: type, kwargs: dict) -> None:
@@ -109,11 +135,17 @@ class HomingEnv(gym.Env):
         self.lighting_change = config.lighting_change
         self.episodes_per_world = config.episodes_per_world
         self._world_episodes_left = 0
+        #: Where the worlds of a procedural scene's unseeded resets come from: built here
+        #: (None) or ahead of need by a :class:`WorldSource` (the native vector env's).
+        self.world_source: WorldSource | None = None
+        self._world_seeds: np.random.SeedSequence | None = None
         self.goal_step_length = config.goal_step_length
         self._lighting: Lighting | None = None
         self.robot_config = config.robot()
         self.odometry = odometry_for(self.robot_config, config.odometry_noise)
         self.odometry_origin = config.odometry_origin
+        #: The ``scene`` argument (a name, ``"mesh:PATH"``, a :class:`Scene`...).
+        self.scene_spec = scene
         self._scene_factory = scene_factory(scene)
         self.scene = self._scene_factory.build(np.random.default_rng(0))
         _check_room(self.scene, self.robot_config.body_radius)
@@ -355,14 +387,26 @@ class HomingEnv(gym.Env):
         if isinstance(seed, (bool, np.bool_)):     # an int to Python, not a seed
             raise ValueError(f"seed must be an integer >= 0 or None, got {seed!r}")
         super().reset(seed=seed)
+        if seed is not None or self._world_seeds is None:
+            self._world_seeds = world_seeds(self.np_random)
         # a randomised scene draws a new world on a seeded reset and every
-        # episodes_per_world unseeded ones (building a procedural world costs tens of ms)
+        # episodes_per_world unseeded ones (building a procedural world costs tens of ms):
+        # a seeded reset's from the seed, the others' from the seed's world stream
+        caster = None
         if self._scene_factory.randomised and (seed is not None
                                                or self._world_episodes_left <= 0):
-            self.scene = self._scene_factory.build(self.np_random)
+            if seed is not None:
+                self.scene = self._scene_factory.build(self.np_random)
+            else:
+                seeds = self._world_seeds.spawn(1)[0]
+                built = self.world_source.world(seeds) if self.world_source else None
+                self.scene, caster = built or (
+                    self._scene_factory.build(np.random.default_rng(seeds)), None)
             self._world_episodes_left = self.episodes_per_world
         self._world_episodes_left -= 1
-        self.sim.reset_world(self.scene)
+        self.sim.reset_world(self.scene, caster)
+        if self.world_source is not None and self._scene_factory.randomised:
+            self.world_source.ahead(self._world_seeds)
         self.episode = self._episode_with_options(
             self.task.sample_episode(self.scene, self.np_random), options or {})
         # the ray caster never sees the robot's body, so it takes the snapshot of each

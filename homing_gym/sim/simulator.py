@@ -70,7 +70,7 @@ class Simulator:
         self._sky_color = sky_color
         #: The ray caster of the current world (``renderer="raycast"``), else None.
         self._shadows = shadows
-        self.caster = (RayCaster(world_mesh(scene), self.sky(scene), shadows)
+        self.caster = (world_caster(scene, self.sky(scene), shadows)
                        if renderer == "raycast" else None)
         self.time_step = time_step
         self._vertices, self._vertices_of = np.zeros((0, 3)), None   # world_vertices' cache
@@ -201,19 +201,20 @@ class Simulator:
         return body
 
     # -- episodes -------------------------------------------------------------------------
-    def reset_world(self, scene: Scene) -> None:
+    def reset_world(self, scene: Scene, caster: RayCaster | None = None) -> None:
         """Bring the world back to its saved state, switching to ``scene`` if it differs:
         a new world is built in the emptied client (PyBullet frees a removed body's
         collision shapes only on ``resetSimulation``; trajectories are the same as with
         the bodies removed one by one, checked on the three procedural worlds with both
-        renderers)."""
+        renderers), with ``caster`` as its ray caster if given (one built elsewhere from
+        :func:`world_caster`)."""
         if scene == self.scene:
             self.client.restoreState(self._state)
             return
         self.client.resetSimulation()
         self._build(scene)
         if self.caster is not None:
-            self.caster = RayCaster(world_mesh(scene), self.sky(scene), self._shadows)
+            self.caster = caster or world_caster(scene, self.sky(scene), self._shadows)
 
     def world_vertices(self) -> np.ndarray:
         """The distinct corners ``(V, 3)`` (metres) of the current world's triangles
@@ -224,8 +225,8 @@ class Simulator:
         return self._vertices
 
     def sky(self, scene: Scene) -> tuple[float, float, float]:
-        """The ray caster's sky: the env's ``sky_color``, else the scene's, else white."""
-        return tuple(self._sky_color or scene.sky_color or SKY_COLOR)
+        """The ray caster's sky in ``scene`` (:func:`world_sky`)."""
+        return world_sky(scene, self._sky_color)
 
     def place_robot(self, pose, clear_contacts: bool = False) -> None:
         """Teleport the robot to ``pose`` (x, y, yaw; metres, radians). With
@@ -268,6 +269,17 @@ class Simulator:
     @property
     def connected(self) -> bool:
         return self._connected
+
+
+def world_sky(scene: Scene, sky_color=None) -> tuple[float, float, float]:
+    """The ray caster's sky: the env's ``sky_color``, else the scene's, else white."""
+    return tuple(sky_color or scene.sky_color or SKY_COLOR)
+
+
+def world_caster(scene: Scene, sky: tuple[float, float, float], shadows: bool) -> RayCaster:
+    """The ray caster of ``scene``'s world mesh under ``sky`` (what a simulator with
+    ``renderer="raycast"`` draws with)."""
+    return RayCaster(world_mesh(scene), sky, shadows)
 
 
 def _face_chunks(vertices: np.ndarray, faces: np.ndarray) -> list[np.ndarray]:

@@ -1,13 +1,16 @@
 """Many homing envs stepped together in one process: the core of the native vector env.
 
 A step of :class:`EnvBatch` moves every robot in turn (PyBullet keeps the GIL, so the
-physics of one process runs on one core) and hands each env's panorama to a render
-thread as soon as its robot has moved: the ray caster's kernels release the GIL, so
-panoramas render on another core while the main thread runs the next robots' physics.
-Each env is an ordinary :class:`~homing_gym.env.HomingEnv`, stepped exactly as alone
-(the same calls in the same order on its own PyBullet client, caster and random
-generator), so env ``i`` of a batch reset with seed ``s + i`` gives the observations,
-rewards and infos of ``gym.make(...)`` reset with that seed, automatic resets included.
+physics of one process runs on one core), then renders their panoramas in threads (the
+ray caster's kernels release the GIL, so they render on every core). Rendering each
+panorama as soon as its robot has moved, beside the next robots' physics, was slower:
+the render threads then wait for the GIL that the physics holds. New worlds of
+procedural scenes are built ahead of need in a :class:`~homing_gym.vector.worlds.WorldBuilder`
+process (``prebuild_worlds``). Each env is an ordinary :class:`~homing_gym.env.HomingEnv`,
+stepped exactly as alone (the same calls in the same order on its own PyBullet client,
+caster and random generator), so env ``i`` of a batch reset with seed ``s + i`` gives
+the observations, rewards and infos of ``gym.make(...)`` reset with that seed,
+automatic resets included.
 
 The batch ends episodes after ``max_episode_steps`` (``truncated``, as Gymnasium's
 ``TimeLimit``) and resets finished envs by Gymnasium's ``AutoresetMode``; it knows
@@ -18,6 +21,7 @@ nothing of how Gymnasium or Stable-Baselines3 lay out a vector step's results
 from __future__ import annotations
 
 import os
+import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
@@ -27,6 +31,7 @@ import numpy as np
 from gymnasium.vector import AutoresetMode
 
 from homing_gym.env import HomingEnv
+from homing_gym.vector.worlds import WorldBuilder
 
 #: Most envs in one vector env (each holds a PyBullet world, a ray caster and its
 #: buffers: several MiB).
@@ -95,11 +100,13 @@ class EnvBatch:
     :class:`~homing_gym.env.HomingEnv`), whose observation and action spaces must be
     equal (``ValueError`` naming the first env that differs). ``threads`` render the
     panoramas (default: one per core); episodes end after ``max_episode_steps``;
-    ``mode`` is the Gymnasium autoreset mode. Actions are checked by the caller."""
+    ``mode`` is the Gymnasium autoreset mode; ``prebuild_worlds`` builds procedural
+    worlds ahead of need. Actions are checked by the caller."""
 
     def __init__(self, makers: Sequence[Callable[[], HomingEnv]], *, threads: int | None = None,
                  max_episode_steps: int | None = None,
-                 mode: AutoresetMode = AutoresetMode.NEXT_STEP, first_index: int = 0):
+                 mode: AutoresetMode = AutoresetMode.NEXT_STEP, first_index: int = 0,
+                 prebuild_worlds: bool = False):
         self.num_envs = len(makers)
         threads = (min(self.num_envs, cores()) if threads is None
                    else checked_count("threads", threads, MAX_THREADS))
@@ -126,10 +133,20 @@ class EnvBatch:
         self.observation_space = first.observation_space
         self.action_space = first.action_space
         self._pool = ThreadPoolExecutor(threads, "homing-render") if threads > 1 else None
+        self._builder = None
+        prebuilt = [env for env in self.envs if isinstance(env.scene_spec, str)
+                    and env.draws_worlds and env.sim.caster is not None]
+        if prebuild_worlds and prebuilt:
+            self._builder = WorldBuilder()
+            for env in prebuilt:
+                env.world_source = self._builder.source(env.scene_spec, env.config.sky_color,
+                                                        env.config.shadows)
         self._elapsed = np.zeros(self.num_envs, np.int64)
         self._autoreset = np.zeros(self.num_envs, np.bool_)
         self.obs: list[dict[str, np.ndarray] | None] = [None] * self.num_envs
         self.started = False
+        #: Seconds spent resetting envs so far (new worlds, goal snapshots).
+        self.reset_seconds = 0.0
 
     def reset(self, seeds: Sequence[int | None], options: dict | None = None,
               mask: np.ndarray | None = None) -> list[dict[str, Any] | None]:
@@ -145,6 +162,7 @@ class EnvBatch:
 
     def _reset(self, i: int, seed: int | None = None, options: dict | None = None
                ) -> dict[str, Any]:
+        start = time.perf_counter()
         try:
             self.obs[i], info = self.envs[i].reset(seed=seed, options=options)
         except ValueError:          # a bad seed or option: the caller's to fix
@@ -153,6 +171,7 @@ class EnvBatch:
             raise self._failed(i, err) from err
         self._elapsed[i] = 0
         self._autoreset[i] = False
+        self.reset_seconds += time.perf_counter() - start
         return info
 
     def step(self, actions: Sequence[Any]) -> StepResults:
@@ -181,8 +200,10 @@ class EnvBatch:
                     moved[i] = env.advance(actions[i])
                 except Exception as err:
                     raise self._failed(i, err) from err
-                if self._pool is not None and not moved[i][3] and env.reads_panorama:
-                    pending[i] = self._pool.submit(env.render_panorama_now)
+            if self._pool is not None:      # PyBullet keeps the GIL: render after physics
+                for i, (_, _, _, skip) in moved.items():
+                    if not skip and self.envs[i].reads_panorama:
+                        pending[i] = self._pool.submit(self.envs[i].render_panorama_now)
             for i, (reward, term, info, skip) in moved.items():
                 try:
                     if i in pending:
@@ -233,6 +254,9 @@ class EnvBatch:
         if self._pool is not None:
             self._pool.shutdown(wait=True)
             self._pool = None
+        if getattr(self, "_builder", None) is not None:
+            self._builder.close()
+            self._builder = None
         for env in self.envs:
             env.close()
         self.closed = True

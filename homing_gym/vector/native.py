@@ -64,13 +64,16 @@ class NativeVectorEnv(gym.vector.VectorEnv):
     keep one observation and action space (else ``ValueError``). ``processes``: 1 (the
     default) steps every env in this process; ``K > 1`` spreads them over ``K`` worker
     processes (:class:`~homing_gym.vector.processes.ProcessBatch`). ``threads``: render
-    threads per process (default: the cores over the processes)."""
+    threads per process (default: the cores over the processes). ``prebuild_worlds``
+    (one process only): a procedural scene's new worlds are built ahead of need in a
+    background process (:mod:`homing_gym.vector.worlds`)."""
 
     def __init__(self, env_id: str, num_envs: int = 1, *,
                  max_episode_steps: int | None = None,
                  autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
                  processes: int = 1, threads: int | None = None,
-                 env_kwargs: Sequence[dict] | None = None, **kwargs):
+                 prebuild_worlds: bool = True, env_kwargs: Sequence[dict] | None = None,
+                 **kwargs):
         self.num_envs = checked_count("num_envs", num_envs, MAX_NUM_ENVS)
         processes = checked_count("processes", processes, self.num_envs)
         mode = autoreset_mode_of(autoreset_mode)
@@ -93,7 +96,10 @@ class NativeVectorEnv(gym.vector.VectorEnv):
                               else max_episode_steps)
         if threads is None:
             threads = max(1, cores() // processes)
-        self.batch = (EnvBatch(makers, threads=threads, max_episode_steps=limit, mode=mode)
+        if not isinstance(prebuild_worlds, bool):
+            raise ValueError(f"prebuild_worlds must be True or False, got {prebuild_worlds!r}")
+        self.batch = (EnvBatch(makers, threads=threads, max_episode_steps=limit, mode=mode,
+                               prebuild_worlds=prebuild_worlds)
                       if processes == 1 else
                       ProcessBatch(makers, processes, threads=threads,
                                    max_episode_steps=limit, mode=mode))

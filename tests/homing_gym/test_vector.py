@@ -228,3 +228,29 @@ def test_close_frees_every_env_and_thread():
     envs.close()
     envs.close()                                      # twice is fine
     assert not any(env.sim.connected for env in inner) and not _render_threads()
+
+
+def test_new_worlds_built_ahead_are_those_the_env_builds_itself():
+    """With a new world every episode and stops every step, the envs' worlds come from
+    the builder process (all but the seeded first ones) and equal those single envs
+    build themselves: the same observations step by step."""
+    native = _native(n=2, **SHORT)
+    single = [gym.make("homing_gym/LocalHoming-v0", **SHORT) for _ in range(2)]
+    try:
+        obs, _ = native.reset(seed=3)
+        for i, env in enumerate(single):
+            env.reset(seed=3 + i)
+        builder = native.unwrapped.batch._builder
+        for _ in range(6):                    # stop, then the next step resets: new worlds
+            obs = native.step(np.full(2, 3))[0]
+            for i, env in enumerate(single):
+                _, _, terminated, _, _ = env.step(3)
+                assert terminated
+            obs = native.step(np.full(2, 3))[0]
+            for i, env in enumerate(single):
+                _assert_same_obs({k: v[i] for k, v in obs.items()}, env.reset()[0])
+        assert builder.served >= 10
+    finally:
+        native.close()
+        for env in single:
+            env.close()

@@ -1,0 +1,134 @@
+"""``homing-benchmark --vec native``: the native vector env against one env in one process.
+
+For each world, in the same run: env steps per second of one env in one process
+(``single``, the reference) and of the native vector env with ``num_envs`` envs in one
+process and in each number of ``processes`` asked for. Each of ``rounds`` rounds runs
+a block of every configuration in turn and medians are reported, so that load from
+other processes hits all of them alike. Actions are random, and each env stops (ends its
+episode) with probability ``1 / episode_steps`` per step, so episodes last about
+``episode_steps`` steps, at different times in different envs, as a trained policy's do.
+Procedural worlds are measured with a new world every episode (``episodes_per_world=1``).
+
+For the vector env in one process the table also gives the median and 99th-percentile
+time of one vector step and the share of the vector steps' time spent resetting envs
+(new worlds built, goal snapshots taken): what a step waits for.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+from tqdm import tqdm
+
+from homing_gym.scenes import scene_factory
+
+
+@dataclass(frozen=True)
+class VectorResult:
+    """One configuration's env steps per second (median over rounds); for vector envs in
+    one process also their step times (seconds) and the share of them spent in resets."""
+
+    world: str
+    config: str
+    steps_per_s: float
+    step_p50: float | None = None
+    step_p99: float | None = None
+    reset_share: float | None = None
+
+
+def _stop_action(space: spaces.Space):
+    return 3 if isinstance(space, spaces.Discrete) else np.zeros(space.shape, space.dtype)
+
+
+def _actions(space: spaces.Space, n: int, p_stop: float, rng: np.random.Generator) -> np.ndarray:
+    """``n`` random actions of ``space``, each the stop action with probability ``p_stop``."""
+    actions = np.array([space.sample() for _ in range(n)])
+    actions[rng.random(n) < p_stop] = _stop_action(space)
+    return actions
+
+
+def world_settings(world: str, world_kwargs: dict) -> dict:
+    """Env kwargs of ``world`` (:func:`homing_gym.benchmark.world_kwargs`); a procedural
+    scene draws a new world every episode."""
+    scene = world_kwargs.get("scene")
+    procedural = isinstance(scene, str) and scene_factory(scene).randomised
+    return {**world_kwargs, **({"episodes_per_world": 1} if procedural else {})}
+
+
+def run(worlds: dict[str, dict], num_envs: int, processes: list[int], steps: int,
+        rounds: int = 10, episode_steps: int = 45, shape: tuple[int, int] = (48, 256),
+        env_id: str = "homing_gym/LocalHoming-v0") -> list[VectorResult]:
+    """Measure every world: ``steps`` env steps per configuration and round."""
+    results = []
+    p_stop = 1.0 / episode_steps
+    for world, kwargs in worlds.items():
+        settings = {**world_settings(world, kwargs), "panorama_shape": shape}
+        single = gym.make(env_id, **settings)
+        single.reset(seed=0)
+        vectors = {p: gym.make_vec(env_id, num_envs=num_envs, processes=p,
+                                   vectorization_mode="vector_entry_point", **settings)
+                   for p in processes}
+        rng = np.random.default_rng(0)
+        rates: dict[str, list[float]] = {"single": [], **{f"native x{p}": [] for p in processes}}
+        times: list[float] = []
+        resets = [0.0, 0.0]                     # seconds resetting, seconds stepping
+        try:
+            for v in vectors.values():
+                v.action_space.seed(0)
+                v.reset(seed=0)
+            single.action_space.seed(0)
+            for _ in tqdm(range(rounds), desc=f"{world}: single env and vector envs in turn"):
+                start = time.perf_counter()
+                for a in _actions(single.action_space, steps, p_stop, rng):
+                    _, _, terminated, truncated, _ = single.step(a)
+                    if terminated or truncated:
+                        single.reset()
+                rates["single"].append(steps / (time.perf_counter() - start))
+                for p, v in vectors.items():
+                    batch = v.unwrapped.batch
+                    before = getattr(batch, "reset_seconds", 0.0)
+                    start = time.perf_counter()
+                    for _ in range(max(steps // num_envs, 1)):
+                        t0 = time.perf_counter()
+                        v.step(_actions(v.single_action_space, num_envs, p_stop, rng))
+                        if p == 1:
+                            times.append(time.perf_counter() - t0)
+                    elapsed = time.perf_counter() - start
+                    rates[f"native x{p}"].append(max(steps // num_envs, 1) * num_envs / elapsed)
+                    if p == 1:
+                        resets[0] += batch.reset_seconds - before
+                        resets[1] += elapsed
+        finally:
+            single.close()
+            for v in vectors.values():
+                v.close()
+        for name, values in rates.items():
+            timed = name == "native x1" and times
+            results.append(VectorResult(
+                world, name, float(np.median(values)),
+                float(np.median(times)) if timed else None,
+                float(np.percentile(times, 99)) if timed else None,
+                resets[0] / resets[1] if timed else None))
+    return results
+
+
+def table(results: list[VectorResult], num_envs: int) -> str:
+    """A Markdown table; ``vs single``: env steps/s over one env's in the same world and
+    run."""
+    single = {r.world: r.steps_per_s for r in results if r.config == "single"}
+    lines = ["| world | configuration | env steps/s | vs single | vector step p50 (ms) | "
+             "p99 (ms) | p99 / p50 | time in resets |", "|---|---|---:|---:|---:|---:|---:|---:|"]
+    for r in results:
+        config = (r.config if r.config == "single" else
+                  f"native, {num_envs} envs in {r.config.split('x')[1]} process"
+                  + ("es" if r.config != "native x1" else ""))
+        timing = ("| - | - | - | - |" if r.step_p50 is None else
+                  f"| {1e3 * r.step_p50:.2f} | {1e3 * r.step_p99:.2f} | "
+                  f"{r.step_p99 / r.step_p50:.2f} | {100 * r.reset_share:.0f}% |")
+        lines.append(f"| {r.world} | {config} | {r.steps_per_s:.0f} | "
+                     f"{r.steps_per_s / single[r.world]:.2f}x {timing}")
+    return "\n".join(lines)
