@@ -30,7 +30,9 @@ from homing_gym.scenes import scene_factory
 @dataclass(frozen=True)
 class VectorResult:
     """One configuration's env steps per second (median over rounds); for vector envs in
-    one process also their step times (seconds) and the share of them spent in resets."""
+    one process also their step times (seconds) and the share of them spent in resets;
+    for the single env the time (seconds per step) in PyBullet's physics (the sub-steps,
+    motor updates and contact checks) and in rendering."""
 
     world: str
     config: str
@@ -38,6 +40,23 @@ class VectorResult:
     step_p50: float | None = None
     step_p99: float | None = None
     reset_share: float | None = None
+    physics_s: float | None = None
+    render_s: float | None = None
+
+
+class _Timed:
+    """Wraps ``obj.name`` (an instance's method) to add up the seconds spent in it."""
+
+    def __init__(self, obj, name: str):
+        self.seconds, self._inner = 0.0, getattr(obj, name)
+        setattr(obj, name, self)
+
+    def __call__(self, *args, **kwargs):
+        start = time.perf_counter()
+        try:
+            return self._inner(*args, **kwargs)
+        finally:
+            self.seconds += time.perf_counter() - start
 
 
 def _stop_action(space: spaces.Space):
@@ -69,6 +88,9 @@ def run(worlds: dict[str, dict], num_envs: int, processes: list[int], steps: int
         settings = {**world_settings(world, kwargs), "panorama_shape": shape}
         single = gym.make(env_id, **settings)
         single.reset(seed=0)
+        physics = _Timed(single.unwrapped.sim, "step")
+        render = _Timed(single.unwrapped.camera, "render")
+        single_steps = 0
         vectors = {p: gym.make_vec(env_id, num_envs=num_envs, processes=p,
                                    vectorization_mode="vector_entry_point", **settings)
                    for p in processes}
@@ -88,6 +110,7 @@ def run(worlds: dict[str, dict], num_envs: int, processes: list[int], steps: int
                     if terminated or truncated:
                         single.reset()
                 rates["single"].append(steps / (time.perf_counter() - start))
+                single_steps += steps
                 for p, v in vectors.items():
                     batch = v.unwrapped.batch
                     before = getattr(batch, "reset_seconds", 0.0)
@@ -106,6 +129,9 @@ def run(worlds: dict[str, dict], num_envs: int, processes: list[int], steps: int
             single.close()
             for v in vectors.values():
                 v.close()
+        results.append(VectorResult(world, "single", float(np.median(rates.pop("single"))),
+                                    physics_s=physics.seconds / single_steps,
+                                    render_s=render.seconds / single_steps))
         for name, values in rates.items():
             timed = name == "native x1" and times
             results.append(VectorResult(
@@ -122,6 +148,10 @@ def table(results: list[VectorResult], num_envs: int) -> str:
     single = {r.world: r.steps_per_s for r in results if r.config == "single"}
     lines = ["| world | configuration | env steps/s | vs single | vector step p50 (ms) | "
              "p99 (ms) | p99 / p50 | time in resets |", "|---|---|---:|---:|---:|---:|---:|---:|"]
+    split = [f"* {r.world}, one env: {1e3 * r.physics_s:.3f} ms of physics and "
+             f"{1e3 * r.render_s:.3f} ms of rendering per step, of "
+             f"{1e3 / r.steps_per_s:.3f} ms ({100 * r.physics_s * r.steps_per_s:.0f}% "
+             f"physics; resets included)" for r in results if r.physics_s is not None]
     for r in results:
         config = (r.config if r.config == "single" else
                   f"native, {num_envs} envs in {r.config.split('x')[1]} process"
@@ -131,4 +161,4 @@ def table(results: list[VectorResult], num_envs: int) -> str:
                   f"{r.step_p99 / r.step_p50:.2f} | {100 * r.reset_share:.0f}% |")
         lines.append(f"| {r.world} | {config} | {r.steps_per_s:.0f} | "
                      f"{r.steps_per_s / single[r.world]:.2f}x {timing}")
-    return "\n".join(lines)
+    return "\n".join(lines + [""] + split)

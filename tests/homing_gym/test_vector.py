@@ -254,3 +254,22 @@ def test_new_worlds_built_ahead_are_those_the_env_builds_itself():
         native.close()
         for env in single:
             env.close()
+
+
+def test_the_vector_benchmark_times_steps_resets_and_the_physics_share(capsys):
+    """``homing-benchmark --vec native``: one row per configuration, vector step
+    percentiles in order, resets counted (stops every 3 steps: many resets), physics and
+    rendering together within a single step's time."""
+    from homing_gym.benchmark import main
+
+    main(["--vec", "native", "--num-envs", "2", "--processes", "2", "--steps", "20",
+          "--episode-steps", "3", "--shapes", "48x256", "--worlds", "random_arena"])
+    from homing_gym.vector import benchmark
+
+    results = benchmark.run({"random_arena": {"scene": "random_arena"}}, 2, [1], 20,
+                            rounds=2, episode_steps=3, shape=(16, 64))
+    single, native = results
+    assert native.step_p50 <= native.step_p99 and 0 < native.reset_share < 1
+    assert 0 < single.physics_s and single.physics_s + single.render_s < 1 / single.steps_per_s
+    out = capsys.readouterr().out
+    assert "| random_arena | native, 2 envs in 2 processes |" in out and "% physics" in out
