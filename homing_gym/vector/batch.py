@@ -132,6 +132,7 @@ class EnvBatch:
             raise
         self.observation_space = first.observation_space
         self.action_space = first.action_space
+        self._threads = threads
         self._pool = ThreadPoolExecutor(threads, "homing-render") if threads > 1 else None
         self._builder = None
         prebuilt = [env for env in self.envs if isinstance(env.scene_spec, str)
@@ -201,13 +202,17 @@ class EnvBatch:
                 except Exception as err:
                     raise self._failed(i, err) from err
             if self._pool is not None:      # PyBullet keeps the GIL: render after physics
-                for i, (_, _, _, skip) in moved.items():
-                    if not skip and self.envs[i].reads_panorama:
-                        pending[i] = self._pool.submit(self.envs[i].render_panorama_now)
+                drawn = [(i, self.envs[i]) for i, (_, _, _, skip) in moved.items()
+                         if not skip and self.envs[i].reads_panorama]
+                pending = {k: self._pool.submit(_render_all, drawn[k::self._threads])
+                           for k in range(min(self._threads, len(drawn)))}
+                for k in list(pending):
+                    failed = pending.pop(k).result()
+                    if failed is not None:
+                        index, error = failed
+                        raise self._failed(index, error) from error
             for i, (reward, term, info, skip) in moved.items():
                 try:
-                    if i in pending:
-                        pending.pop(i).result()
                     self.obs[i] = self.envs[i].observation(skip)
                 except Exception as err:
                     raise self._failed(i, err) from err
@@ -260,6 +265,17 @@ class EnvBatch:
         for env in self.envs:
             env.close()
         self.closed = True
+
+
+def _render_all(envs: list[tuple[int, HomingEnv]]) -> tuple[int, Exception] | None:
+    """Render the panoramas of ``envs`` (index, env) in turn (one render thread's
+    share); the index and error of the first that fails, else ``None``."""
+    for i, env in envs:
+        try:
+            env.render_panorama_now()
+        except Exception as err:        # noqa: BLE001  said by the caller, with the index
+            return i, err
+    return None
 
 
 def stacked(observations: Sequence[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
