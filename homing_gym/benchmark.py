@@ -41,6 +41,7 @@ from tqdm import tqdm
 
 import homing_gym  # noqa: F401  (registers the envs)
 from homing_gym.cli import command_parser, worker_count
+from homing_gym.config import MOTIONS
 from homing_gym.outputs import output_file_argument, write_text_atomic
 from homing_gym.scenes import Landmark, MeshScene, Scene, scene_factory, square_walls
 from homing_gym.scenes.tussocks import tussock_blades
@@ -316,6 +317,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="worker process counts measured beside one process (--vec native)")
     parser.add_argument("--episode-steps", type=worker_count, default=45,
                         help="mean episode length of the random actions (--vec native)")
+    parser.add_argument("--motion", choices=MOTIONS, default=MOTIONS[0],
+                        help="the robot's motion model in every configuration (--vec "
+                             "native; 'kinematic': homing_gym.sim.kinematic)")
     args = parser.parse_args(argv)
     if args.steps < 10 or args.resets < 0:
         parser.error("need --steps >= 10 and --resets >= 0")
@@ -341,7 +345,7 @@ def _native(args, parser) -> int:
     if any(p > args.num_envs for p in args.processes):
         parser.error(f"--processes {args.processes}: at most --num-envs ({args.num_envs})")
     try:
-        worlds = {w: world_kwargs(w) for w in args.worlds}
+        worlds = {w: {**world_kwargs(w), "motion": args.motion} for w in args.worlds}
     except ValueError as err:
         parser.error(f"--worlds: {err}")
     results = vector_benchmark.run(worlds, args.num_envs, sorted({1, *args.processes}),

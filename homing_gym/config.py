@@ -23,6 +23,8 @@ from homing_gym.validation import (interval, is_real, require_number, require_po
                                    require_sequence)
 
 RENDER_MODES = ("human", "rgb_array")
+#: How the robot moves (``motion``): PyBullet's physics or a kinematic unicycle.
+MOTIONS = ("pybullet", "kinematic")
 ACTION_TYPES = ("continuous", "discrete")
 #: Where ``odometry`` starts: zero in the start pose's frame (path integration from where
 #: the robot was put), or the start pose in home's frame (a privileged homing vector).
@@ -168,6 +170,10 @@ class EnvConfig:
         PHYSICS_SUBSTEPS, Range(f"physics steps of [1/{round(1 / MIN_TIME_STEP)}, "
                                 f"1/{round(1 / MAX_TIME_STEP)}] s", 1, MAX_SUBSTEPS,
                                 integer=True), "", "physics steps per control period")
+    motion: str = _arg("pybullet", Choices(values=MOTIONS), "",
+                       "how the robot moves: PyBullet's physics, or a kinematic unicycle "
+                       "that obstacles stop (faster; differential drive and "
+                       f"{RAYCAST_ONLY}; `homing_gym.sim.kinematic` says how it differs)")
     odometry_noise: float = _arg(0.02, Range(low=0, high=MAX_ODOMETRY_NOISE), "",
                                  "each encoder increment scaled by 1 + N(0, noise)")
     odometry_origin: str = _arg("start", Choices(values=ODOMETRY_ORIGINS), "",
@@ -226,6 +232,10 @@ class EnvConfig:
         if self.shadows and not raycast:
             raise ValueError(f"shadows needs renderer='raycast', got "
                              f"renderer={self.renderer!r}")
+        if self.motion == "kinematic" and (self.drive != "differential" or not raycast):
+            raise ValueError(f"motion='kinematic' needs drive='differential' and "
+                             f"renderer='raycast' (the robot has no body for PyBullet to "
+                             f"draw), got drive={self.drive!r}, renderer={self.renderer!r}")
         if self.drive == "synchro" and self.action_type != "continuous":
             raise ValueError("drive='synchro' takes continuous actions (vx, vy); got "
                              f"action_type={self.action_type!r}")

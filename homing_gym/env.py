@@ -45,9 +45,14 @@ ROOM_RESOLUTION = 0.05
 
 def simulation_settings(env_kwargs: dict) -> dict:
     """The renderer and physics sub-steps an env made with ``env_kwargs`` runs with (the
-    given ones, else the defaults): what result files record beside the policy."""
-    return {"renderer": env_kwargs.get("renderer", EnvConfig.renderer),
-            "physics_substeps": env_kwargs.get("physics_substeps", EnvConfig.physics_substeps)}
+    given ones, else the defaults), and its motion model unless PyBullet's: what result
+    files record beside the policy."""
+    settings = {"renderer": env_kwargs.get("renderer", EnvConfig.renderer),
+                "physics_substeps": env_kwargs.get("physics_substeps",
+                                                   EnvConfig.physics_substeps)}
+    if env_kwargs.get("motion", EnvConfig.motion) != EnvConfig.motion:
+        settings["motion"] = env_kwargs["motion"]     # named in every row that uses it
+    return settings
 
 
 def _check_room(scene: Scene, radius: float) -> None:
@@ -153,7 +158,8 @@ class HomingEnv(gym.Env):
         self.sim = Simulator(self.scene, gui=self.render_mode == "human",
                              time_step=self.control_period / self.physics_substeps,
                              robot_config=self.robot_config, renderer=config.renderer,
-                             sky_color=config.sky_color, shadows=config.shadows)
+                             sky_color=config.sky_color, shadows=config.shadows,
+                             motion=config.motion)
         self.camera = PanoramaCamera(
             config.camera(), self.robot_config.camera_height, renderer=self.sim.renderer,
             caster=(lambda: self.sim.caster) if self.sim.caster is not None else None,

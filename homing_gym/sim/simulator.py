@@ -28,6 +28,7 @@ from pybullet_utils.bullet_client import BulletClient
 
 from homing_gym.native_output import native_output_captured
 from homing_gym.render.raycast import SKY_COLOR, RayCaster
+from homing_gym.sim.kinematic import KinematicRobot
 from homing_gym.sim.robot import Robot, RobotConfig
 from homing_gym.scenes.base import Scene
 from homing_gym.scenes.footprint import band_faces
@@ -60,7 +61,8 @@ class Simulator:
 
     def __init__(self, scene: Scene, *, gui: bool = False, time_step: float = 1 / 120,
                  robot_config: RobotConfig = RobotConfig(), renderer: str = "raycast",
-                 sky_color: tuple[float, float, float] | None = None, shadows: bool = False):
+                 sky_color: tuple[float, float, float] | None = None, shadows: bool = False,
+                 motion: str = "pybullet"):
         with native_output_captured():    # the C++ core prints "argv[0]=" on connecting
             self.client = BulletClient(connection_mode=p.GUI if gui else p.DIRECT)
         self._connected = True
@@ -79,6 +81,10 @@ class Simulator:
         #: bodies get visual shapes, colours and textures (the ray caster draws its own).
         self._drawn = self.caster is None or gui
         self._robot_config = robot_config
+        #: ``"pybullet"``: the URDF robot in PyBullet's physics; ``"kinematic"``: a
+        #: :class:`~homing_gym.sim.kinematic.KinematicRobot` (the world's bodies stay, for
+        #: rays and views).
+        self.motion = motion
         self._step_simulation = c.stepSimulation      # BulletClient builds a new partial on
         self._contact_points = c.getContactPoints     # every attribute access: keep these
         self._build(scene)
@@ -99,7 +105,8 @@ class Simulator:
         self.wall_ids = [self._body(wall_solid(w)) for w in scene.walls]
         self.fence_ids = ([self._body(s, visible=False) for s in fence_solids(scene)]
                           if scene.fence else [])
-        self.robot = Robot(c, self._robot_config)
+        self.robot = (KinematicRobot(scene, self._robot_config) if self.motion == "kinematic"
+                      else Robot(c, self._robot_config))
         self.landmark_ids = [self._body(landmark_solid(lm)) for lm in scene.landmarks]
         self.mesh_ids = [body for part in scene.meshes
                          for body in self._make_part(part, scene.height_band)]
@@ -235,7 +242,7 @@ class Simulator:
         the next steps do not depend on where the robot stood before."""
         x, y, yaw = (float(v) for v in pose)
         self.robot.set_pose(x, y, yaw)
-        if clear_contacts:
+        if clear_contacts and self.motion == "pybullet":
             self.robot.set_pose(x + 100.0, y, yaw)
             self.robot.set_pose(x, y, yaw)
 
@@ -247,6 +254,8 @@ class Simulator:
 
     def step(self, substeps: int) -> bool:
         """Advance the physics ``substeps`` times; True if the robot touched an obstacle."""
+        if self.motion == "kinematic":
+            return self.robot.move(substeps, self.time_step)
         touched = False
         step, update_motors = self._step_simulation, self.robot.update_motors
         for _ in range(substeps):

@@ -88,7 +88,7 @@ def run(worlds: dict[str, dict], num_envs: int, processes: list[int], steps: int
         settings = {**world_settings(world, kwargs), "panorama_shape": shape}
         single = gym.make(env_id, **settings)
         single.reset(seed=0)
-        physics = _Timed(single.unwrapped.sim, "step")
+        physics = _Timed(single.unwrapped.sim, "step")      # the kinematic robot's too
         render = _Timed(single.unwrapped.camera, "render")
         single_steps = 0
         vectors = {p: gym.make_vec(env_id, num_envs=num_envs, processes=p,
