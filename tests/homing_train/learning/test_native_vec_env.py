@@ -61,3 +61,26 @@ def test_train_makes_native_envs_and_reaches_them_with_env_method():
         assert obs["panorama"].shape == (3, 3, 16, 64)       # channel-first, as SB3 wants
     finally:
         env.close()
+
+
+def test_homing_train_runs_with_the_native_vector_env(tmp_path):
+    """``homing-train --vec native --workers 2``: a short run writes its folder and
+    records how its envs ran."""
+    import json
+
+    import yaml
+
+    from homing_train.learning.train import main
+
+    run = tmp_path / "run"
+    assert main(["--timesteps", "128", "--n-envs", "2", "--vec", "native", "--workers", "2",
+                 "--env-kwargs", json.dumps({"panorama_shape": [36, 64],
+                                             "max_episode_steps": 16}),
+                 "--no-progress", "--hp", "n_steps=64", "--hp", "batch_size=32",
+                 "--hp", "n_epochs=1", "--hp", "eval_freq=64", "--hp", "eval_episodes=1",
+                 "--hp", "checkpoint_freq=64", "--hp", "features_dim=32",
+                 "--out", str(run)]) == 0
+    config = yaml.safe_load((run / "config.yml").read_text())
+    assert (config["vec"], config["workers"]) == ("native", 2)
+    assert (run / "model.zip").is_file() and json.loads((run / "summary.json").read_text())[
+        "timesteps"] == 128
