@@ -177,6 +177,78 @@ def test_controller_reaches_home_from_1m_in_arena(free_start):
     assert sum(successes) >= 3, (successes, collisions)
 
 
+def _pose(x, y, heading=0.0):
+    from homing_baselines.distance import PoseEstimate
+    return PoseEstimate(x, y, heading, 0.02, ((0, 0), (1, 1), (2, 2), (3, 3)), 4)
+
+
+def test_arrival_needs_two_agreeing_estimates_with_the_nest_in_reach():
+    """The stop decision from hand-made estimates (arrival rule, docs/yu_kim.md): the nest
+    within one move of the current estimate, and the previous estimate carried forward
+    by the commanded motion agreeing with it within the tolerance."""
+    from homing_baselines.distance import arrival_confirmed, carry_forward
+
+    # previous estimate 0.5 m east of the nest facing west; it moved 0.3 m home, then
+    # probed 0.16 m on: now 0.04 m west of the nest
+    prev = _pose(0.5, 0.0, math.pi)
+    motion = (0.46, 0.0, 0.0)
+    assert carry_forward(prev, motion)[:2] == pytest.approx([0.04, 0.0], abs=1e-12)
+    # a turn of 90 degrees to the left, then 0.2 m: the heading turns the displacement
+    turned = carry_forward(_pose(0.0, 0.0, math.pi / 2), (0.0, 0.2, math.pi / 2))
+    assert turned == pytest.approx([-0.2, 0.0, math.pi], abs=1e-12)
+    reach, tol = 0.3, 0.15
+    # no previous estimate: never (a single localisation may be a wrong arrangement)
+    assert not arrival_confirmed(None, None, _pose(0.05, 0.0), reach, tol)
+    # agreeing within 0.15 m and the nest in reach: arrive
+    assert arrival_confirmed(prev, motion, _pose(-0.02, 0.05), reach, tol)
+    # a jump: the current estimate puts the robot 0.1 m from the nest, but 0.3 m from
+    # where the previous one and the motion put it -> no stop
+    assert not arrival_confirmed(prev, motion, _pose(0.0, 0.1 + 0.2), reach, tol)
+    assert not arrival_confirmed(prev, motion, _pose(-0.05, -0.25), reach, tol)
+    # agreeing, but the nest beyond one move: go on
+    far = _pose(0.9, 0.0, math.pi)
+    assert not arrival_confirmed(far, (0.46, 0.0, 0.0), _pose(0.44, 0.0), reach, tol)
+    # a sequence of estimates as the controller sees them: stop at the first pair
+    # that agrees with the nest in reach
+    seq = [(_pose(1.0, 0.0, math.pi), (0.46, 0.0, 0.0)),
+           (_pose(0.52, 0.01, math.pi), (0.46, 0.0, 0.0)),  # agrees, nest 0.52 m: go on
+           (_pose(0.2, -0.2, math.pi), (0.2, 0.0, 0.0)),    # 0.28 m, 0.25 m off: a jump
+           (_pose(0.02, -0.19, math.pi), None)]             # agrees, 0.19 m: arrive
+    decisions = [arrival_confirmed(a[0], a[1], b[0], reach, tol)
+                 for a, b in zip(seq, seq[1:])]
+    assert decisions == [False, False, True]
+    with pytest.raises(ValueError):
+        DistanceController(confirm_tolerance=0.0)
+
+
+@pytest.mark.slow
+def test_controller_stops_within_the_radius_of_the_nest(free_start):
+    """Under the stop rule (``success_on="stop"``, the ``yukim`` protocol's): from three
+    starts 0.5-1.0 m from the arena's nest, the controller issues stop within 0.15 m.
+    Starts chosen by hand, none of the protocol's draws."""
+    gym = pytest.importorskip("gymnasium")
+    import homing_gym  # noqa: F401
+    from homing_train.harness.evaluate import run_episode
+    from homing_train.harness.rollout import prepare_policy
+
+    env = gym.make("homing_gym/LocalHoming-v0", obs_keys=("panorama", "goal", "goal_step"),
+                   scene="arena", max_episode_steps=300, success_on="stop",
+                   renderer="tiny", physics_substeps=24)
+    controller = DistanceController()
+    prepare_policy(controller, env)
+    home = (0.0, 0.0, 0.0)
+    try:
+        records = [run_episode(env, controller, 11 + k,
+                               start=free_start(env, home, dist, bearing, heading),
+                               home=home)
+                   for k, (dist, bearing, heading) in enumerate(
+                       ((0.5, 0.2, 2.0), (0.8, 2.4, -1.0), (1.0, -1.9, 0.5)))]
+    finally:
+        env.close()
+    outcome = [(r.terminated, round(r.final_distance, 3)) for r in records]
+    assert all(r.terminated and r.success for r in records), outcome
+
+
 def test_free_direction_steers_around_a_landmark_ahead():
     from homing_baselines.distance import free_direction, view_obstacles
 
