@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 
 from homing_gym.geometry import wrap_angle
 from homing_gym.scenes.base import Scene, clearances
@@ -68,29 +69,19 @@ class KinematicRobot:
         stopped the body."""
         c = self.config
         limit = c.wheel_acceleration / c.wheel_radius * time_step
-        x, y, yaw = (float(v) for v in self._pose)
-        poses = []
-        for _ in range(substeps):
-            self._current = [s + max(-limit, min(limit, t - s))
-                             for s, t in zip(self._current, self._target)]
-            left, right = self._current
-            self._angles += (left * time_step, right * time_step)
-            v = (left + right) / 2 * c.wheel_radius
-            w = (right - left) * c.wheel_radius / c.wheel_separation
-            mid = yaw + w * time_step / 2
-            x, y = x + v * time_step * math.cos(mid), y + v * time_step * math.sin(mid)
-            yaw += w * time_step
-            poses.append((x, y, yaw))
-        path = np.array(poses)
+        current = np.array(self._current, np.float64)
+        path, turned = _unicycle_path(self._pose, current, np.array(self._target, np.float64),
+                                      limit, time_step, substeps, c.wheel_radius,
+                                      c.wheel_separation)
+        self._current = current.tolist()
+        self._angles += turned
         free = clearances(self.scene, np.vstack([self._pose[:2], path[:, :2]]))
         blocked = (free[1:] < c.body_radius) & (free[1:] < free[:-1])
-        if blocked.any():
-            k = int(np.argmax(blocked))
-            if k > 0:
-                self._pose = np.array([*path[k - 1, :2], wrap_angle(path[k - 1, 2])])
-            return True
-        self._pose = np.array([x, y, wrap_angle(yaw)])
-        return False
+        k = int(np.argmax(blocked)) if blocked.any() else substeps
+        if k > 0:
+            x, y, yaw = path[k - 1]
+            self._pose = np.array([x, y, wrap_angle(yaw)])
+        return k < substeps
 
     def pose(self) -> np.ndarray:
         """The pose ``(x, y, yaw)`` (metres, radians)."""
@@ -101,3 +92,27 @@ class KinematicRobot:
         return self._angles.copy()
 
     wheel_angles = encoders
+
+
+@njit(cache=True)
+def _unicycle_path(pose: np.ndarray, current: np.ndarray, target: np.ndarray, limit: float,
+                   dt: float, n: int, wheel_radius: float, separation: float
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """The poses ``(n, 3)`` after each of ``n`` sub-steps of ``dt`` seconds from ``pose``
+    with the wheel speeds ``current`` (rad/s, updated in place) ramped towards ``target``
+    by at most ``limit`` a sub-step, and the wheel angles turned (radians)."""
+    path = np.empty((n, 3))
+    turned = np.zeros(2)
+    x, y, yaw = pose[0], pose[1], pose[2]
+    for k in range(n):
+        for side in range(2):
+            current[side] += max(-limit, min(limit, target[side] - current[side]))
+            turned[side] += current[side] * dt
+        v = (current[0] + current[1]) / 2 * wheel_radius
+        w = (current[1] - current[0]) * wheel_radius / separation
+        mid = yaw + w * dt / 2
+        x += v * dt * math.cos(mid)
+        y += v * dt * math.sin(mid)
+        yaw += w * dt
+        path[k, 0], path[k, 1], path[k, 2] = x, y, yaw
+    return path, turned
