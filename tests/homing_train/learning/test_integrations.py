@@ -32,6 +32,26 @@ def test_gymnasium_async_vector_env_with_spawn():
     envs.close()
 
 
+def test_native_vector_env_and_its_sb3_view_train_a_short_ppo_run():
+    from stable_baselines3 import PPO
+
+    from homing_train.learning.extractor import policy_kwargs_for
+    from homing_train.learning.native_vec_env import native_vec_env
+
+    envs = gym.make_vec("homing_gym/LocalHoming-v0", num_envs=2,
+                        vectorization_mode="vector_entry_point", **SMALL)
+    obs, _ = envs.reset(seed=0)
+    assert obs["panorama"].shape == (2, 16, 64, 3)
+    assert envs.step(envs.action_space.sample())[1].shape == (2,)
+    envs.close()
+    venv = native_vec_env("homing_gym/LocalHoming-v0", [SMALL] * 2)
+    model = PPO("MultiInputPolicy", venv, n_steps=32, batch_size=32, n_epochs=1,
+                policy_kwargs=policy_kwargs_for("panorama"))
+    model.learn(64)
+    assert model.num_timesteps == 64
+    venv.close()
+
+
 def test_sb3_make_vec_env_and_a_short_ppo_run():
     from stable_baselines3 import PPO
     from stable_baselines3.common.env_util import make_vec_env
