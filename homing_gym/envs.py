@@ -17,6 +17,7 @@ from homing_gym.scenes.landmark_changes import changed_landmarks
 from homing_gym.tasks import (LocalHomingTask, LongRangeHomingTask, RewardConfig,
                               RouteFollowingTask)
 from homing_gym.tasks.landmark_navigation import LandmarkNavigationTask
+from homing_gym.tasks.route_following import ROUTE_VIEW_SPACING
 from homing_gym.tasks.work_locations import MAX_POINTS, TAUGHT_KEYS, WorkLocationsTask
 from homing_gym.teaching import PLACE_SPACING
 from homing_gym.tasks.goal_reaching import MAX_SUCCESS_RADIUS
@@ -198,7 +199,20 @@ class RouteFollowingEnv(HomingEnv):
     As ``LocalHoming-v0`` (``obs_keys``): ``panorama``, ``goal`` (the current target's
     snapshot), optional ``omni``, ``goal_omni``, ``signature``, ``goal_signature``,
     ``odometry`` (zero at the start; with ``odometry_origin="home"`` the pose in the
-    frame of the last target).
+    frame of the last target), and, only when asked for, the route's teaching views:
+
+    | key | space | meaning |
+    |---|---|---|
+    | `route_views` | `Box(0, 255, (K, H, W, 3), uint8)` | the panoramas taken while the robot was led along the route (the views a familiarity method learns from, Baddeley et al. 2012), in travel order: `K = ceil(L / route_view_spacing) + 1` places evenly spread over the route's length `L`, the first at the start point, the last at the last target, each facing the direction of travel there (column `W/2`); constant during an episode |
+
+    ``route_views`` are taken at reset under the snapshots' lighting, in the episode's
+    world (once per world: a fixed scene's are taken once), from the route as taught
+    (the start point before its jitter), so they cost ``K`` renders per new world and
+    ``K`` panoramas in every observation: ask for them with ``obs_keys``, e.g.
+    ``obs_keys=("panorama", "goal", "route_views")``. For the default hallway route
+    (5.18 m) and ``route_view_spacing`` = 0.1 m, ``K`` = 53. A route shorter than
+    ``route_view_spacing`` (fewer than two views) or one needing more than 512 views
+    raises ``ValueError`` naming ``route_view_spacing``.
 
     ## Rewards
 
@@ -256,17 +270,22 @@ class RouteFollowingEnv(HomingEnv):
         "spacing": ("[0.05, 100]", "metres", "distance between the straight route's targets"),
         "route": ("`None`, points or a file (see above)", "metres, radians",
                   "any other route: the start, then the targets"),
+        "route_view_spacing": ("[0.01, 2], at most the route's length", "metres",
+                               "largest distance between the teaching views "
+                               "`route_views`"),
         "start_jitter": START_JITTER, "success_radius": SUCCESS_RADIUS,
         "success_on": SUCCESS_ON, "reward": REWARD}
 
     def __init__(self, scene: str | Scene = "hallway", *, n_targets: int = 17,
                  spacing: float = FOOT,
                  route: Sequence[Sequence[float]] | str | os.PathLike | None = None,
+                 route_view_spacing: float = ROUTE_VIEW_SPACING,
                  start_jitter: tuple[float, float] = (0.05, 0.1745),
                  success_radius: float = 0.1, success_on: str = "stop",
                  reward: RewardConfig = RewardConfig(), **kwargs):
         check_env_kwargs(type(self), kwargs)
         task = RouteFollowingTask(n_targets=n_targets, spacing=spacing, route=route,
+                                  route_view_spacing=route_view_spacing,
                                   start_jitter=start_jitter, success_radius=success_radius,
                                   success_on=success_on, reward=reward)
         super().__init__(task, scene, **kwargs)

@@ -1,6 +1,15 @@
 """Route following: visit a sequence of target places, each known by its snapshot
 (Hong et al. 1991 §5: 17 targets about 1 ft apart in a hallway, the robot starting 1 ft
-before the first), or the targets of a route given as points (curved routes)."""
+before the first), or the targets of a route given as points (curved routes).
+
+Teaching views (opt-in, observation key ``route_views``): the panoramas the robot took
+while it was led along the route, for methods that learn a route from the views along it
+(familiarity-based route following, Baddeley et al. 2012). They are taken at
+:func:`route_view_poses`, each facing the direction of travel there, under snapshot-time
+lighting (as the targets' snapshots), once per episode at reset (once per world: a world
+that does not change keeps its views), and reach the agent through the observation, never
+through ``info``.
+"""
 
 from __future__ import annotations
 
@@ -12,7 +21,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from gymnasium import spaces
+
 from homing_gym.geometry import FOOT, wrap_angle
+from homing_gym.observations import ObservationKey
 from homing_gym.paths import BODY_RADIUS, joined_in_order
 from homing_gym.scenes.base import MAX_SIDE, Scene, clearances
 from homing_gym.tasks.context import TaskContext
@@ -26,6 +38,12 @@ from homing_gym.validation import require_number
 N_TARGETS, SPACING = 17, FOOT
 #: Least distance (metres) between consecutive points of a given route.
 MIN_ROUTE_STEP = 0.05
+#: Default, least and largest distance (metres) between the route's teaching views.
+ROUTE_VIEW_SPACING, MIN_ROUTE_VIEW_SPACING, MAX_ROUTE_VIEW_SPACING = 0.1, 0.01, 2.0
+#: Most teaching views one route may have (each a full panorama in every observation).
+MAX_ROUTE_VIEWS = 512
+#: The observation key of the teaching views.
+ROUTE_VIEWS_KEY = "route_views"
 
 
 def _is_sequence(value) -> bool:
@@ -72,6 +90,41 @@ def route_poses(route: Sequence[Sequence[float]]) -> np.ndarray:
     return np.column_stack([xy, yaws])
 
 
+def route_view_poses(points, spacing: float) -> np.ndarray:
+    """The poses ``(K, 3)`` (x, y, yaw) of the teaching views along the polyline
+    ``points`` (``(N, 2+)``, metres: the start point, then the targets): ``K =
+    ceil(L / spacing) + 1`` places evenly spread over its length ``L``, the first at the
+    start, the last at the last target, consecutive places at most ``spacing`` apart along
+    the route; each faces the direction of travel there (the leg that leaves it; at the
+    last target, the last leg's). ``ValueError`` naming ``route_view_spacing`` when the
+    route is shorter than ``spacing`` (fewer than two views: nothing to follow) or needs
+    more than :data:`MAX_ROUTE_VIEWS` views."""
+    xy = np.asarray(points, np.float64)[:, :2]
+    legs = np.diff(xy, axis=0)
+    lengths = np.hypot(legs[:, 0], legs[:, 1])
+    total = float(lengths.sum())
+    if total < spacing:
+        raise ValueError(f"route_view_spacing {spacing!r} m: the route is only {total:.3f} m "
+                         f"long, too short for teaching views (at least two, "
+                         f"route_view_spacing apart); give a route_view_spacing of at most "
+                         f"{total:.3f} m or a longer route")
+    count = int(math.ceil(total / spacing - 1e-9)) + 1
+    if count > MAX_ROUTE_VIEWS:
+        raise ValueError(f"route_view_spacing {spacing!r} m: the route of {total:.2f} m needs "
+                         f"{count} teaching views, at most {MAX_ROUTE_VIEWS}; use a "
+                         f"route_view_spacing of at least "
+                         f"{math.ceil(total / (MAX_ROUTE_VIEWS - 1) * 1000) / 1000:.3f} m")
+    cum = np.concatenate([[0.0], np.cumsum(lengths)])
+    stations = np.linspace(0.0, total, count)
+    leg = np.clip(np.searchsorted(cum, stations, side="right") - 1, 0, len(legs) - 1)
+    while np.any(lengths[leg] == 0):          # (consecutive points are apart: never)
+        leg = np.minimum(leg + (lengths[leg] == 0), len(legs) - 1)
+    along = np.clip((stations - cum[leg]) / lengths[leg], 0.0, 1.0)
+    places = xy[leg] + legs[leg] * along[:, None]
+    places[-1] = xy[-1]
+    return np.column_stack([places, np.arctan2(legs[leg, 1], legs[leg, 0])])
+
+
 class RouteFollowingTask(GoalReachingTask):
     """By default ``n_targets`` target poses ``spacing`` metres apart on a straight line
     from the scene's ``metadata["route_origin"]`` (x, y, yaw), all facing along the route,
@@ -84,18 +137,25 @@ class RouteFollowingTask(GoalReachingTask):
     robot's body; each point must be joined to the next by a path for a disc of that
     radius (:meth:`check_scene`). A target counts as reached within ``success_radius``
     (default 0.1 m, a third of the spacing), or, with ``success_on="stop"``, when the
-    agent stops; then the next target's snapshot becomes the goal."""
+    agent stops; then the next target's snapshot becomes the goal.
+
+    Teaching views (observation key :data:`ROUTE_VIEWS_KEY`, when asked for): the
+    panoramas at :func:`route_view_poses` of the route (start point and targets as
+    taught, before the start's jitter), at most ``route_view_spacing`` metres apart."""
 
     def __init__(self, n_targets: int = N_TARGETS, spacing: float = SPACING,
                  start_jitter: tuple[float, float] = (0.05, math.radians(10)),
                  success_radius: float = 0.1, success_on: str = "stop",
                  reward: RewardConfig = RewardConfig(), clearance_margin: float = 0.18,
-                 route: Sequence[Sequence[float]] | str | os.PathLike | None = None):
+                 route: Sequence[Sequence[float]] | str | os.PathLike | None = None,
+                 route_view_spacing: float = ROUTE_VIEW_SPACING):
         route = load_route(route)                       # a path: the points of its file
         require_number("n_targets", n_targets, 1, MAX_ROUTE_POINTS - 1, "(a route holds at "
                        f"most {MAX_ROUTE_POINTS} points with its start)", integer=True)
         require_number("spacing", spacing, MIN_ROUTE_STEP, MAX_SIDE, "metres (the least "
                        "step of a route; the largest side of a scene)")
+        require_number("route_view_spacing", route_view_spacing, MIN_ROUTE_VIEW_SPACING,
+                       MAX_ROUTE_VIEW_SPACING, "metres (between the route's teaching views)")
         start_jitter = checked_start_jitter(start_jitter)
         if route is not None and (n_targets != N_TARGETS or spacing != SPACING):
             raise ValueError(f"n_targets ({n_targets!r}) and spacing ({spacing!r}) describe the "
@@ -107,6 +167,9 @@ class RouteFollowingTask(GoalReachingTask):
         self.spacing = float(spacing)
         self.start_jitter = start_jitter
         self.clearance_margin = clearance_margin
+        self.route_view_spacing = float(route_view_spacing)
+        self._views: np.ndarray | None = None
+        self._views_scene: Scene | None = None
 
     def _route(self, scene: Scene) -> np.ndarray:
         """The start point, then the targets: poses ``(n_targets + 1, 3)``."""
@@ -195,6 +258,33 @@ class RouteFollowingTask(GoalReachingTask):
         start = before + np.array([rng.uniform(-d, d), rng.uniform(-d, d), rng.uniform(-a, a)])
         start[2] = wrap_angle(start[2])
         return Episode(home=targets[-1], start=start, waypoints=tuple(targets[:-1]))
+
+    # -- teaching views -----------------------------------------------------------------------
+    def _view_count(self) -> int:
+        """How many teaching views the route has (:func:`route_view_poses`; its length does
+        not depend on the scene); ``ValueError`` naming ``route_view_spacing`` when the
+        route is too short for them or needs too many."""
+        if self.route is not None:
+            points = self.route
+        else:        # the straight route: n_targets spacings from the start point
+            points = np.array([[0.0, 0.0], [self.n_targets * self.spacing, 0.0]])
+        return len(route_view_poses(points, self.route_view_spacing))
+
+    def on_reset(self, ctx: TaskContext) -> None:
+        if ROUTE_VIEWS_KEY in ctx.obs_keys and ctx.scene() is not self._views_scene:
+            poses = route_view_poses(self._route(ctx.scene()), self.route_view_spacing)
+            self._views = np.stack([ctx.snapshot(pose) for pose in poses])
+            self._views_scene = ctx.scene()
+            ctx.place_robot(ctx.episode().start, self.fresh_contacts)
+        super().on_reset(ctx)
+
+    def observation_keys(self) -> dict[str, ObservationKey]:
+        def space(config):
+            count = self._view_count()
+            return spaces.Box(0, 255, (count, *config.panorama_shape, 3), np.uint8)
+
+        return {ROUTE_VIEWS_KEY: ObservationKey(space, lambda sight: self._views.copy(),
+                                                rendered=False)}
 
     def extra_info(self, ctx: TaskContext) -> dict:
         return {"target_index": ctx.goal_index(), "target_errors": list(self.goal_errors)}
