@@ -20,9 +20,11 @@ from homing_baselines.bearing_longrange import LongRangeBearingController
 from homing_baselines.alv import ALVController
 from homing_baselines.did import DIDController
 from homing_baselines.distance import DistanceController
+from homing_baselines.infomax import InfomaxController
 from homing_baselines.min_warping import MinWarpingController
 from homing_baselines.multires import MultiResController
 from homing_baselines.oracle import OracleController
+from homing_baselines.perfect_memory import PerfectMemoryController
 from homing_baselines.random_walk import RandomController
 from homing_baselines.selfsimilar import SelfSimilarController
 from homing_baselines.snapshot import SnapshotController
@@ -81,6 +83,8 @@ register("multires", MultiResController)
 register("alv", ALVController)
 register("did", DIDController)
 register("min-warping", MinWarpingController)
+register("perfect-memory", PerfectMemoryController)
+register("infomax", InfomaxController)
 
 __all__ = ["Controller", "MotionHelper", "MotionSpec", "Move", "OracleController",
            "RandomController", "available", "controller_class", "make", "parameters",

@@ -1,9 +1,9 @@
 """One colour per method in every plot, from colour-blind-safe palettes.
 
-Known methods have fixed colours (Okabe & Ito's eight, Paul Tol's muted set, then
-ColorBrewer's dark brown, dark green and dark purple); any other name (a user's controller or policy) gets a colour
-from the rest, chosen by a stable hash of the name, so it is the same in every plot and
-run. Home and start markers use shapes and colours outside these (:data:`HOME_MARK`,
+Known methods have fixed colours (Okabe & Ito's eight, Paul Tol's muted set and two of
+his bright set, then ColorBrewer's dark brown, dark green and dark purple); any other
+name (a user's controller or policy) gets a colour from the rest, chosen by a stable
+hash of the name, so it is the same in every plot and run. Home and start markers use shapes and colours outside these (:data:`HOME_MARK`,
 :data:`START_MARK`).
 """
 
@@ -11,18 +11,20 @@ from __future__ import annotations
 
 import zlib
 
-#: Okabe & Ito (2008), Tol's muted scheme, ColorBrewer's BrBG dark brown and PRGn dark
-#: green and dark purple, RGB in [0, 1].
+#: Okabe & Ito (2008), Tol's muted scheme (and his bright blue and yellow),
+#: ColorBrewer's BrBG dark brown and PRGn dark green and dark purple, RGB in [0, 1].
 _HEX = {"black": "000000", "orange": "E69F00", "sky": "56B4E9", "green": "009E73",
         "blue": "0072B2", "vermillion": "D55E00", "purple": "CC79A7", "grey": "999999",
         "indigo": "332288", "teal": "44AA99", "olive": "999933", "wine": "882255",
         "rose": "CC6677", "sand": "DDCC77", "brown": "8C510A", "forest": "1B7837",
-        "plum": "762A83", "cyan": "88CCEE", "tol-green": "117733", "tol-purple": "AA4499"}
+        "plum": "762A83", "cyan": "88CCEE", "tol-green": "117733", "tol-purple": "AA4499",
+        "tol-blue": "4477AA", "tol-yellow": "CCBB44"}
 _FIXED = {"oracle": "black", "random": "grey", "snapshot": "orange", "warping": "sky",
           "distance": "blue", "bearing": "purple", "bearing-basic": "rose",
           "bearing-complementary": "wine", "bearing-longrange": "indigo",
           "selfsimilar": "olive", "multires": "teal",
           "alv": "tol-purple", "did": "cyan", "min-warping": "tol-green",
+          "perfect-memory": "tol-blue", "infomax": "tol-yellow",
           # the shipped learned policies (train/shipped/)
           "ppo_procedural_long": "plum", "ppo_procedural_imitation": "green"}
 _SPARE = ("vermillion", "sand", "brown", "forest")
