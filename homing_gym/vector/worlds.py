@@ -45,8 +45,8 @@ def _serve(conn) -> None:
     """The builder process: build each requested world, in order, until the pipe closes."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
-        while True:
-            key, request = conn.recv()
+        while (message := conn.recv()) is not None:      # None: close
+            key, request = message
             try:
                 conn.send((key, _build(*request)))
             except Exception:           # noqa: BLE001  the env builds it, and says why
@@ -128,13 +128,18 @@ class WorldBuilder:
         return world
 
     def close(self) -> None:
-        """Stop the process and the receiver; safe to call more than once."""
-        self._conn.close()
+        """Stop the process, then the receiver (the pipe's end tells it); safe to call
+        more than once."""
+        try:
+            self._conn.send(None)
+        except OSError:
+            pass
         self._process.join(CLOSE_TIMEOUT)
         if self._process.is_alive():
             self._process.kill()
             self._process.join()
         self._receiver.join(CLOSE_TIMEOUT)
+        self._conn.close()
         self._done.clear()
 
 
