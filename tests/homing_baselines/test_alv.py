@@ -13,6 +13,10 @@ from homing_baselines.alv import (ALVConfig, ALVController, average_landmark_vec
                                   circular_runs, segment_landmarks)
 from homing_gym.geometry import wrap_angle
 
+#: LocalHoming-v0 settings of the ``arena`` fixture (tests/homing_baselines/conftest.py).
+ARENA = {"obs_keys": ("panorama", "goal", "odometry"), "start_distance": (0.3, 0.6)}
+
+
 LANDMARKS = np.array([[1.0, 0.4], [-0.6, 1.1], [-0.9, -0.7], [0.5, -1.2], [1.4, -0.3]])
 
 
@@ -37,29 +41,11 @@ def test_circular_runs_join_across_the_seam():
     assert circular_runs(np.zeros(5, bool)) == []
 
 
-@pytest.fixture(scope="module")
-def arena():
-    gym = pytest.importorskip("gymnasium")
-    import homing_gym  # noqa: F401
-
-    env = gym.make("homing_gym/LocalHoming-v0", obs_keys=("panorama", "goal", "odometry"),
-                   start_distance=(0.3, 0.6))
-    env.reset(seed=0)
-    yield env
-    env.close()
-
-
-def _render(env, pose):
-    u = env.unwrapped
-    u.sim.robot.set_pose(*pose)
-    return u.render_panorama(np.asarray(pose, dtype=np.float64))
-
-
-def test_rendered_cylinders_are_the_dark_landmarks(arena):
+def test_rendered_cylinders_are_the_dark_landmarks(arena, panorama_at):
     """From the arena's centre the four red cylinders are four dark segments at their
     bearings (within 5 deg)."""
     pose = (0.0, 0.0, 0.3)
-    marks = segment_landmarks(_render(arena, pose))
+    marks = segment_landmarks(panorama_at(pose))
     truth = [math.atan2(y, x) - pose[2] for x, y in ((0.45, 0.35), (-0.35, 0.55),
                                                      (-0.55, -0.25), (0.3, -0.5))]
     assert marks.bearings.size == 4
@@ -67,11 +53,11 @@ def test_rendered_cylinders_are_the_dark_landmarks(arena):
         assert min(abs(math.degrees(wrap_angle(b - t))) for b in marks.bearings) < 5
 
 
-def test_rendered_home_vector_with_the_true_rotation_points_home(arena):
+def test_rendered_home_vector_with_the_true_rotation_points_home(panorama_at):
     """Given the true rotation, ALV homing from rendered views 0.7 m from home points
     home within 30 deg (median over 6 directions; each within 60 deg)."""
     home = np.array([0.05, -0.1, 0.4])
-    h0 = average_landmark_vector(segment_landmarks(_render(arena, home)).bearings)
+    h0 = average_landmark_vector(segment_landmarks(panorama_at(home)).bearings)
     errors = []
     for k in range(6):
         a = k * math.pi / 3 + 0.3
@@ -79,7 +65,7 @@ def test_rendered_home_vector_with_the_true_rotation_points_home(arena):
         if max(abs(pose[0]), abs(pose[1])) > 1.0:
             continue
         psi = pose[2] - home[2]
-        v = average_landmark_vector(segment_landmarks(_render(arena, pose)).bearings + psi) - h0
+        v = average_landmark_vector(segment_landmarks(panorama_at(pose)).bearings + psi) - h0
         truth = math.atan2(home[1] - pose[1], home[0] - pose[0]) - home[2]
         errors.append(abs(math.degrees(wrap_angle(math.atan2(v[1], v[0]) - truth))))
     assert len(errors) >= 3 and np.median(errors) < 30 and max(errors) < 60, errors

@@ -13,22 +13,8 @@ from homing_baselines.did import (DIDController, grey_panorama, plane_gradient, 
 from homing_gym.geometry import wrap_angle
 
 
-@pytest.fixture(scope="module")
-def arena():
-    gym = pytest.importorskip("gymnasium")
-    import homing_gym  # noqa: F401
-
-    env = gym.make("homing_gym/LocalHoming-v0", obs_keys=("panorama", "goal"),
-                   start_distance=(0.3, 0.6))
-    env.reset(seed=0)
-    yield env
-    env.close()
-
-
-def _render(env, pose):
-    u = env.unwrapped
-    u.sim.robot.set_pose(*pose)
-    return u.render_panorama(np.asarray(pose, dtype=np.float64))
+#: LocalHoming-v0 settings of the ``arena`` fixture (tests/homing_baselines/conftest.py).
+ARENA = {"obs_keys": ("panorama", "goal"), "start_distance": (0.3, 0.6)}
 
 
 def test_ridf_of_a_rolled_image_is_zero_at_the_roll():
@@ -38,20 +24,20 @@ def test_ridf_of_a_rolled_image_is_zero_at_the_roll():
     assert rms_difference(image, image) == 0.0
 
 
-def test_rendered_compass_and_idf_grow_with_distance(arena):
+def test_rendered_compass_and_idf_grow_with_distance(arena, panorama_at):
     """Pure rotations are found within 6 deg (one column of the reduced image); the
     rotation-invariant IDF grows with the distance from home (0 -> 0.05 -> 0.1 m) in
     every one of 6 directions (further out the arena's IDF is no longer monotonic in
     every direction: docs/did.md)."""
     home = (0.05, -0.1, 0.4)
-    goal = grey_panorama(_render(arena, home), 2)
+    goal = grey_panorama(panorama_at(home), 2)
     for turn in (0.9, -2.0, 3.0):
-        psi, d, _ = visual_compass(grey_panorama(_render(arena, (0.05, -0.1, 0.4 + turn)), 2),
+        psi, d, _ = visual_compass(grey_panorama(panorama_at((0.05, -0.1, 0.4 + turn)), 2),
                                    goal)
         assert abs(math.degrees(wrap_angle(psi - turn))) < 6
     for k in range(6):
         a = k * math.pi / 3 + 0.3
-        values = [visual_compass(grey_panorama(_render(arena, (
+        values = [visual_compass(grey_panorama(panorama_at((
             home[0] + r * math.cos(a), home[1] + r * math.sin(a), 1.1 * k)), 2), goal)[1]
             for r in (0.0, 0.05, 0.1)]
         assert values[0] < values[1] < values[2], (a, values)
@@ -64,18 +50,18 @@ def test_plane_gradient_is_exact_on_a_plane_and_refuses_collinear_points():
     assert plane_gradient(np.array([[0, 0], [1, 1], [2, 2.0]]), np.zeros(3)) is None
 
 
-def test_descent_direction_from_rendered_probes_points_home(arena):
+def test_descent_direction_from_rendered_probes_points_home(arena, panorama_at):
     """The descent direction from three rendered samples 0.05 m apart, 0.15 m from home,
     points home within 35 deg in at least 5 of 6 directions (the sixth straddles a ridge
     of the arena's IDF), median error below 20 deg."""
     home = (0.05, -0.1, 0.4)
-    goal = grey_panorama(_render(arena, home), 2)
+    goal = grey_panorama(panorama_at(home), 2)
     errors = []
     for k in range(6):
         a = k * math.pi / 3 + 0.3
         base = np.array([home[0] + 0.15 * math.cos(a), home[1] + 0.15 * math.sin(a)])
         pts = np.array([base, base + [0.05, 0], base + [0.05, 0.05]])
-        d = [visual_compass(grey_panorama(_render(arena, (*p, 0.7 * k)), 2), goal)[1]
+        d = [visual_compass(grey_panorama(panorama_at((*p, 0.7 * k)), 2), goal)[1]
              for p in pts]
         g = plane_gradient(pts, np.array(d))
         descent = math.atan2(-g[1], -g[0])

@@ -13,6 +13,10 @@ from homing_baselines.min_warping import (MinWarpingConfig, MinWarpingController
 from homing_gym.geometry import wrap_angle
 
 
+#: LocalHoming-v0 settings of the ``arena`` fixture (tests/homing_baselines/conftest.py).
+ARENA = {"obs_keys": ("panorama", "goal"), "start_distance": (0.5, 1.5)}
+
+
 def _world(seed=1, count=14):
     rng = np.random.default_rng(seed)
     xy = np.c_[rng.uniform(-2, 2, count), rng.uniform(-2, 2, count)]
@@ -57,28 +61,10 @@ def test_identical_views_give_no_displacement():
     assert min_warp(image, image).rho == 0.0
 
 
-@pytest.fixture(scope="module")
-def arena():
-    gym = pytest.importorskip("gymnasium")
-    import homing_gym  # noqa: F401
-
-    env = gym.make("homing_gym/LocalHoming-v0", obs_keys=("panorama", "goal"),
-                   start_distance=(0.5, 1.5))
-    env.reset(seed=0)
-    yield env
-    env.close()
-
-
-def _render(env, pose):
-    u = env.unwrapped
-    u.sim.robot.set_pose(*pose)
-    return u.render_panorama(np.asarray(pose, dtype=np.float64))
-
-
-def test_rendered_rotation_is_found_and_is_no_displacement(arena):
+def test_rendered_rotation_is_found_and_is_no_displacement(panorama_at):
     home = (0.05, -0.1, 0.4)
-    goal = column_image(_render(arena, home))
-    result = min_warp(goal, column_image(_render(arena, (0.05, -0.1, 1.3))))
+    goal = column_image(panorama_at(home))
+    result = min_warp(goal, column_image(panorama_at((0.05, -0.1, 1.3))))
     assert abs(math.degrees(wrap_angle(result.psi - 0.9))) < 6
     assert result.rho == 0.0
 

@@ -13,6 +13,10 @@ from homing_gym.geometry import wrap_angle
 from homing_gym.render.panorama import column_bearing
 
 
+#: LocalHoming-v0 settings of the ``arena`` fixture (tests/homing_baselines/conftest.py).
+ARENA = {"obs_keys": ("panorama", "goal")}
+
+
 def test_warp_bearings_match_exact_geometry_on_the_landmark_circle():
     rng = np.random.default_rng(0)
     theta = rng.uniform(-np.pi, np.pi, 50)  # landmarks on the unit circle about home
@@ -45,38 +49,21 @@ def test_search_recovers_a_synthetic_displacement():
         warp_search(np.zeros(10), np.zeros(12))
 
 
-@pytest.fixture(scope="module")
-def arena():
-    gym = pytest.importorskip("gymnasium")
-    import homing_gym  # noqa: F401
-
-    env = gym.make("homing_gym/LocalHoming-v0", obs_keys=("panorama", "goal"))
-    env.reset(seed=0)
-    yield env
-    env.close()
-
-
-def _render(env, pose):
-    u = env.unwrapped
-    u.sim.robot.set_pose(*pose)
-    return u.render_panorama(np.asarray(pose, dtype=np.float64))
-
-
-def test_rendered_rotation_is_found_without_displacement(arena):
+def test_rendered_rotation_is_found_without_displacement(panorama_at):
     home = (0.05, -0.1, 0.4)
-    _, psi, result = warping_homing(_render(arena, (0.05, -0.1, 1.3)), _render(arena, home))
+    _, psi, result = warping_homing(panorama_at((0.05, -0.1, 1.3)), panorama_at(home))
     assert result.rho == 0.0
     assert abs(wrap_angle(psi - 0.9)) < math.radians(2)
 
 
-def test_rendered_pairs_03m_apart_point_home(arena):
+def test_rendered_pairs_03m_apart_point_home(panorama_at):
     home = np.array([0.05, -0.1, 0.4])
-    goal = _render(arena, home)
+    goal = panorama_at(home)
     errors = []
     for k in range(8):
         a = k * math.pi / 4
         pose = (home[0] + 0.3 * math.cos(a), home[1] + 0.3 * math.sin(a), 0.5 - 0.7 * k)
-        direction, _, _ = warping_homing(_render(arena, pose), goal)
+        direction, _, _ = warping_homing(panorama_at(pose), goal)
         truth = math.atan2(home[1] - pose[1], home[0] - pose[0]) - pose[2]
         errors.append(abs(math.degrees(wrap_angle(direction - truth))))
     assert max(errors) < 30, errors
@@ -94,13 +81,13 @@ def test_controller_reaches_home_from_05m(arena, free_start):
         assert run_episode(arena, controller, 0, start=start, home=home).success, start
 
 
-def test_controller_follows_a_new_goal_image(arena):
+def test_controller_follows_a_new_goal_image(panorama_at):
     """On a route the goal image changes mid-episode: the controller must home on the new
     one (it stops where the new goal was taken), not on the first snapshot."""
     controller = WarpingController()
     controller.reset()
-    here = _render(arena, (0.05, -0.1, 0.4))
-    first_goal = _render(arena, (-0.5, 0.4, 0.4))
+    here = panorama_at((0.05, -0.1, 0.4))
+    first_goal = panorama_at((-0.5, 0.4, 0.4))
     assert controller.decide({"panorama": here, "goal": first_goal}) is not None
     assert controller.decide({"panorama": here, "goal": here.copy()}) is None
 
