@@ -125,20 +125,14 @@ class NativeVectorEnv(gym.vector.VectorEnv):
                                      and mask.shape == (self.num_envs,) and mask.any()):
             raise ValueError(f"options['reset_mask'] must be a bool array of shape "
                              f"({self.num_envs},) with at least one True, got {mask!r}")
-        infos: dict[str, Any] = {}
-        for i, info in enumerate(self.batch.reset(seeds, options or None, mask)):
-            if info is not None:
-                infos = self._add_info(infos, info, i)
+        infos = self._batched_infos(self.batch.reset(seeds, options or None, mask))
         return self.batch.stacked_obs(), infos
 
     def step(self, actions):
         self._check_open()
         results = self.batch.step(self.checked_actions(actions))
-        infos: dict[str, Any] = {}
-        for i, info in enumerate(results.infos):
-            infos = self._add_info(infos, info, i)
         return (self.batch.stacked_obs(), results.rewards, results.terminated,
-                results.truncated, infos)
+                results.truncated, self._batched_infos(results.infos))
 
     def render(self) -> tuple[Any, ...] | None:
         """Each env's :meth:`~homing_gym.env.HomingEnv.render` (``rgb_array`` pictures;
@@ -170,18 +164,37 @@ class NativeVectorEnv(gym.vector.VectorEnv):
         self.batch.close()
 
     # -- helpers --------------------------------------------------------------------------
-    def _add_info(self, vector_infos: dict[str, Any], env_info: dict[str, Any],
-                  env_num: int) -> dict[str, Any]:
-        """Gymnasium's layout of infos, where an array whose shape differs between envs
-        (a route's waypoints) is kept per env in an object array."""
-        for key, value in env_info.items():
-            have = vector_infos.get(key)
-            if (isinstance(value, np.ndarray) and isinstance(have, np.ndarray)
-                    and have.dtype != object and have.shape[1:] != value.shape):
-                ragged = np.empty(self.num_envs, object)
-                ragged[:] = list(have)
-                vector_infos[key] = ragged
-        return super()._add_info(vector_infos, env_info, env_num)
+    def _batched_infos(self, infos: Sequence[dict[str, Any] | None]) -> dict[str, Any]:
+        """The envs' infos (``None`` where an env has none) in Gymnasium's layout (what
+        ``VectorEnv._add_info`` builds env by env, here key by key): each key's values
+        in an array of the first env's type (numbers), stacked (arrays), per env in an
+        object array (other values, ``final_obs``, arrays whose shape differs between
+        envs, such as a route's waypoints), nested dicts alike, with a ``_key`` mask of
+        the envs that have it."""
+        keys = dict.fromkeys(k for info in infos if info for k in info)
+        out: dict[str, Any] = {}
+        for key in keys:
+            have = np.array([bool(info) and key in info for info in infos])
+            values = [info[key] for info in infos if info and key in info]
+            first = values[0]
+            if isinstance(first, dict) and key != "final_obs":
+                out[key] = self._batched_infos([info.get(key) if info else None
+                                                for info in infos])
+            elif key != "final_obs" and (type(first) in (int, float, bool)
+                                         or issubclass(type(first), np.number)):
+                out[key] = np.zeros(self.num_envs, dtype=type(first))
+                out[key][have] = values
+            elif (key != "final_obs" and isinstance(first, np.ndarray)
+                  and all(isinstance(v, np.ndarray) and v.shape == first.shape
+                          for v in values)):
+                out[key] = np.zeros((self.num_envs, *first.shape), first.dtype)
+                out[key][have] = values
+            else:
+                out[key] = np.full(self.num_envs, None, dtype=object)
+                for i, value in zip(np.flatnonzero(have), values):
+                    out[key][i] = value
+            out[f"_{key}"] = have
+        return out
 
     def _seeds(self, seed) -> list[int | None]:
         if seed is None:

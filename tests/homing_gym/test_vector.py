@@ -273,3 +273,37 @@ def test_the_vector_benchmark_times_steps_resets_and_the_physics_share(capsys):
     assert 0 < single.physics_s and single.physics_s + single.render_s < 1 / single.steps_per_s
     out = capsys.readouterr().out
     assert "| random_arena | native, 2 envs in 2 processes |" in out and "% physics" in out
+
+
+def _assert_same_infos(a, b):
+    """Equal Gymnasium vector infos: the same keys, masks and values (nested dicts and
+    object arrays of observations compared element by element)."""
+    assert a.keys() == b.keys(), (sorted(a), sorted(b))
+    for key in a:
+        x, y = a[key], b[key]
+        if isinstance(y, dict):
+            _assert_same_infos(x, y)
+        elif y.dtype == object:
+            for u, v in zip(x, y):
+                if isinstance(v, dict):
+                    _assert_same_obs(u, v)
+                else:
+                    assert (u is None and v is None) or np.array_equal(u, v), key
+        else:
+            assert x.dtype == y.dtype, key
+            np.testing.assert_array_equal(x, y, err_msg=key)
+
+
+@pytest.mark.parametrize("mode", [AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP])
+def test_infos_have_gymnasiums_layout_exactly(mode):
+    """Every info key, mask, dtype and value of 25 steps with automatic resets (nested
+    rewards, final observations and infos) equals what Gymnasium's SyncVectorEnv builds."""
+    native = _native(n=3, max_episode_steps=5, autoreset_mode=mode, **SHORT)
+    sync = _sync(n=3, max_episode_steps=5, mode=mode, **SHORT)
+    try:
+        _assert_same_infos(native.reset(seed=2)[1], sync.reset(seed=2)[1])
+        for actions in _discrete_actions(25, 3, seed=4):
+            _assert_same_infos(native.step(actions)[4], sync.step(actions)[4])
+    finally:
+        native.close()
+        sync.close()
