@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 from homing_gym.render.panorama import N_VIEWS, PANORAMA_SHAPES, RENDERERS, CameraConfig
+from homing_gym.scenes.appearance import CAMERA_HEIGHT_RANGE
 from homing_gym.sim.robot import DRIVES, MAX_ODOMETRY_NOISE, RobotConfig
 from homing_gym.sim.simulator import gui_unavailable
 from homing_gym.validation import (interval, is_real, require_number, require_positive,
@@ -57,7 +58,8 @@ class Rule:
 
 @dataclass(frozen=True)
 class Range(Rule):
-    """A real number (an integer when ``integer``) between ``low`` and ``high``."""
+    """A real number (an integer when ``integer``) between ``low`` and ``high``, or
+    ``None`` when ``optional``."""
 
     text: str = ""
     low: float = 0.0
@@ -65,15 +67,19 @@ class Range(Rule):
     integer: bool = False
     low_open: bool = False
     high_open: bool = False
+    optional: bool = False
 
-    def check(self, name: str, value: Any, unit: str) -> float:
+    def check(self, name: str, value: Any, unit: str) -> float | None:
+        if value is None and self.optional:
+            return None
         return require_number(name, value, self.low, self.high, unit, integer=self.integer,
                               low_open=self.low_open, high_open=self.high_open)
 
     def __str__(self) -> str:
         kind = "integer in " if self.integer else ""
-        return kind + interval(self.low, self.high, self.integer, self.low_open,
-                               self.high_open) + (f"; {self.text}" if self.text else "")
+        return (kind + interval(self.low, self.high, self.integer, self.low_open,
+                                self.high_open) + (", or `None`" if self.optional else "")
+                + (f"; {self.text}" if self.text else ""))
 
 
 @dataclass(frozen=True)
@@ -147,11 +153,14 @@ class EnvConfig:
     sky_color: tuple[float, float, float] | None = _arg(
         None, Rule(f"three RGB values in [0, 1], or `None`; {RAYCAST_ONLY}"), "",
         "colour of rays that hit nothing (`None`: the scene's)")
-    shadows: bool = _arg(False, Rule(f"`True`, `False`; {RAYCAST_ONLY}"), "",
-                         "objects cast shadows from the scene light")
-    camera_height: float = _arg(RobotConfig.camera_height, Range(low=0.005, high=5.0),
-                                "metres", "camera above the floor (below the robot's top, "
-                                "about 0.1 m, the ray caster never sees the robot's body)")
+    shadows: bool | None = _arg(None, Rule(f"`True`, `False`, `None`; {RAYCAST_ONLY}"), "",
+                                "objects cast shadows from the scene light (`None`: as the "
+                                "world says, else none)")
+    camera_height: float | None = _arg(
+        None, Range(low=CAMERA_HEIGHT_RANGE[0], high=CAMERA_HEIGHT_RANGE[1], optional=True),
+        "metres", f"camera above the floor (`None`: the world's, else "
+        f"{RobotConfig.camera_height:g}; below the robot's top, about 0.1 m, only the ray "
+        f"caster does not see the robot's body)")
     action_type: str = _arg("continuous", Choices(values=ACTION_TYPES), "",
                             "`Box(-1, 1, (2,))` (forward, yaw rate) or `Discrete(4)`")
     drive: str = _arg(RobotConfig.drive, Choices(values=DRIVES), "",
@@ -227,8 +236,8 @@ class EnvConfig:
             if not all(is_real(c) and 0 <= c <= 1 for c in rgb):
                 raise ValueError(f"sky_color must be {what}, got {self.sky_color!r}")
             object.__setattr__(self, "sky_color", rgb)
-        if self.shadows not in (True, False):
-            raise ValueError(f"shadows must be True or False, got {self.shadows!r}")
+        if self.shadows not in (True, False, None):
+            raise ValueError(f"shadows must be True, False or None, got {self.shadows!r}")
         if self.shadows and not raycast:
             raise ValueError(f"shadows needs renderer='raycast', got "
                              f"renderer={self.renderer!r}")
@@ -240,10 +249,13 @@ class EnvConfig:
             raise ValueError("drive='synchro' takes continuous actions (vx, vy); got "
                              f"action_type={self.action_type!r}")
 
-    def robot(self) -> RobotConfig:
-        """The robot's settings."""
+    def robot(self, world_camera_height: float | None = None) -> RobotConfig:
+        """The robot's settings, its camera ``camera_height`` metres up, else
+        ``world_camera_height`` (a world's appearance), else the robot's default."""
+        height = next((h for h in (self.camera_height, world_camera_height) if h is not None),
+                      RobotConfig.camera_height)
         return RobotConfig(max_speed=self.max_speed, max_yaw_rate=self.max_yaw_rate,
-                           camera_height=self.camera_height, drive=self.drive)
+                           camera_height=height, drive=self.drive)
 
     def camera(self) -> CameraConfig:
         """The panoramic camera's settings."""

@@ -23,7 +23,8 @@ from homing_gym.config import EnvConfig, env_config
 from homing_gym.geometry import finite_pose, to_frame
 from homing_gym.observations import (CORE_KEYS, PANORAMA_KEYS, ObservationKey, Sight,
                                      goal_step_key)
-from homing_gym.render.panorama import Lighting, PanoramaCamera, random_lighting
+from homing_gym.render.panorama import (Lighting, PanoramaCamera, random_lighting,
+                                        world_lighting)
 from homing_gym.paths import occupancy
 from homing_gym.render.perspective import PerspectiveConfig, render_perspective
 from homing_gym.render.raycast import RayCaster
@@ -145,14 +146,17 @@ class HomingEnv(gym.Env):
         self.world_source: WorldSource | None = None
         self._world_seeds: np.random.SeedSequence | None = None
         self.goal_step_length = config.goal_step_length
+        #: The run's lighting (the world's, or changed: ``lighting_change``) and the
+        #: world's own, under which snapshots are taken (None: the renderers' default).
         self._lighting: Lighting | None = None
-        self.robot_config = config.robot()
-        self.odometry = odometry_for(self.robot_config, config.odometry_noise)
-        self.odometry_origin = config.odometry_origin
+        self._world_lighting: Lighting | None = None
         #: The ``scene`` argument (a name, ``"mesh:PATH"``, a :class:`Scene`...).
         self.scene_spec = scene
         self._scene_factory = scene_factory(scene)
         self.scene = self._scene_factory.build(np.random.default_rng(0))
+        self.robot_config = config.robot(self.scene.appearance.camera_height)
+        self.odometry = odometry_for(self.robot_config, config.odometry_noise)
+        self.odometry_origin = config.odometry_origin
         _check_room(self.scene, self.robot_config.body_radius)
         task.check_scene(self.scene)
         self.sim = Simulator(self.scene, gui=self.render_mode == "human",
@@ -260,7 +264,18 @@ class HomingEnv(gym.Env):
         standing there (it stays there) when ``move_robot``."""
         if move_robot:
             self.sim.robot.set_pose(*pose)
-        return self.camera.render(self.sim.client, pose)
+        return self.camera.render(self.sim.client, pose, self._world_lighting)
+
+    def _use_appearance(self) -> None:
+        """Take the current world's light and camera height
+        (:class:`~homing_gym.scenes.appearance.Appearance`; the env's ``camera_height``
+        wins over the world's)."""
+        self._world_lighting = world_lighting(self.scene.appearance)
+        robot = self.config.robot(self.scene.appearance.camera_height)
+        if robot != self.robot_config:
+            self.robot_config = robot
+            self.camera.camera_height = robot.camera_height
+            self._task_context = dataclasses.replace(self._task_context, robot=robot)
 
     def _place_robot(self, pose, clear_contacts: bool = False) -> None:
         """Teleport the robot to ``pose`` and restart odometry there: at zero
@@ -411,6 +426,7 @@ class HomingEnv(gym.Env):
             self._world_episodes_left = self.episodes_per_world
         self._world_episodes_left -= 1
         self.sim.reset_world(self.scene, caster)
+        self._use_appearance()
         if self.world_source is not None and self._scene_factory.randomised:
             self.world_source.ahead(self._world_seeds)
         self.episode = self._episode_with_options(
@@ -424,7 +440,7 @@ class HomingEnv(gym.Env):
         self.goal_index = 0
         self._goal_obs = self._goal_views[0]
         self._lighting = (random_lighting(self.np_random, self.lighting_change)
-                          if self.lighting_change > 0 else None)
+                          if self.lighting_change > 0 else self._world_lighting)
         self._place_robot(self.episode.start, self.task.fresh_contacts)
         self._start_pose = self.pose.copy()
         self._panorama = None

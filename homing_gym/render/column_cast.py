@@ -822,7 +822,8 @@ def shade(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: np.nd
           shadow_origin: np.ndarray, shadow_cell: float) -> None:
     """The image ``out (H/k, W/k, 3)`` (uint8) from the ``(H, W)`` rays' hits: each
     pixel the mean of its ``k x k`` rays' colours (``k = H / out.shape[0]``), each colour
-    ``sky`` where nothing was hit, else the triangle's lit colour ``base`` times its
+    the sky where nothing was hit (``sky (h, w, 3)``: ray ``(i, j)``'s sky is
+    ``sky[i, j]``, along an axis of length 1 the same for every ray), else the triangle's lit colour ``base`` times its
     texture (``u`` left to right, ``v`` bottom to top, wrapped), clipped to ``[0, 1]``.
     The mean is summed in float32 in row-major order (for ``k = 2`` bit for bit OpenCV's
     box average, ``INTER_AREA``), then scaled to 0-255 and rounded half up.
@@ -892,7 +893,8 @@ def _lit_rays(hit: np.ndarray, weights: np.ndarray, base: np.ndarray, texture: n
     for i in range(hit.shape[0]):
         t = hit[i, j]
         if t < 0:
-            color[i, 0], color[i, 1], color[i, 2] = sky[0], sky[1], sky[2]
+            si, sj = (i if sky.shape[0] > 1 else 0), (j if sky.shape[1] > 1 else 0)
+            color[i, 0], color[i, 1], color[i, 2] = sky[si, sj, 0], sky[si, sj, 1], sky[si, sj, 2]
             continue
         r, g, b = base[t, 0], base[t, 1], base[t, 2]
         tex = texture[t]

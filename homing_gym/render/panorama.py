@@ -39,6 +39,7 @@ import numpy as np
 import pybullet as p
 from pybullet_utils.bullet_client import BulletClient
 
+from homing_gym.scenes.appearance import Appearance
 from homing_gym.validation import require_number
 from homing_gym.vision import horizon_line
 
@@ -147,6 +148,16 @@ def random_lighting(rng: np.random.Generator, strength: float) -> Lighting:
 
 
 DEFAULT_LIGHTING = Lighting()
+
+
+def world_lighting(appearance: Appearance) -> Lighting | None:
+    """The lighting of a world's :class:`~homing_gym.scenes.appearance.Appearance`
+    (its light's direction, ambient and diffuse terms), ``None`` where it has no light
+    of its own (the renderers' default)."""
+    if appearance.light_direction is None:
+        return None
+    return Lighting(direction=appearance.light_direction, ambient=appearance.ambient,
+                    diffuse=appearance.diffuse)
 
 
 def photometric(image: np.ndarray, lighting: Lighting | None) -> np.ndarray:

@@ -17,7 +17,9 @@ only its ``1/k`` share Hong's route following still lost targets on some seeds:
 :class:`~homing_gym.render.panorama.Lighting` direction ``l``, ``n`` the face's normal on the
 side the camera sees: a face turned away from the light gets the ambient term alone, as
 in TinyRenderer, so walls of different orientation differ in brightness), clipped, then
-the lighting's brightness/contrast change; rays that hit nothing see ``sky_color``. With
+the lighting's brightness/contrast change; rays that hit nothing see ``sky_color``, or
+with a ``sky_zenith`` colour the blend of the two linear in the ray's elevation (the
+horizon's colour at and below the horizon, the zenith's straight up). With
 ``supersampling = k`` each pixel averages ``k x k`` rays spread evenly over its area
 (panoramas: ``CameraConfig.supersampling``, perspective views:
 :data:`~homing_gym.render.perspective.VIEW_SUPERSAMPLING`). The
@@ -172,13 +174,17 @@ def texel_density(mesh: WorldMesh) -> np.ndarray:
 class RayCaster:
     """Casts and shades rays in one world mesh; rebuilt when the world changes."""
 
-    def __init__(self, mesh: WorldMesh, sky_color=SKY_COLOR, shadows: bool = False):
+    def __init__(self, mesh: WorldMesh, sky_color=SKY_COLOR, shadows: bool = False,
+                 sky_zenith=None):
         if len(mesh.triangles) == 0:
             raise ValueError("the world mesh has no triangles")
         if not np.all(np.isfinite(mesh.triangles)):
             raise ValueError("the world mesh has non-finite vertices")
         self.mesh = mesh
         self.sky = np.asarray(sky_color, np.float64)
+        #: The sky straight up (RGB), or None: a uniform sky.
+        self.sky_zenith = None if sky_zenith is None else np.asarray(sky_zenith, np.float64)
+        self._skies: dict[int, tuple[Rays, np.ndarray]] = {}
         self._tris = mesh.triangles.astype(np.float64)
         self._normals = mesh.normals.astype(np.float64)
         self._closed = mesh.closed.astype(np.bool_)
@@ -233,6 +239,19 @@ class RayCaster:
                                      np.empty((W, H)))
         return self._scratch[(H, W)]
 
+    def _sky(self, rays: Rays) -> np.ndarray:
+        """The sky colour of each of ``rays`` as :func:`shade` reads it: ``(1, 1, 3)``
+        when uniform, ``(H, 1, 3)`` for a panorama's even rows, else ``(H, W, 3)``; kept
+        per ray layout."""
+        if self.sky_zenith is None:
+            return self.sky.reshape(1, 1, 3)
+        if id(rays) not in self._skies:
+            tan = rays.tan_elev[:, :1] if rays.even_rows else rays.tan_elev
+            up = np.clip(np.arctan(tan) / (np.pi / 2), 0.0, 1.0)[..., None]
+            sky = np.ascontiguousarray(self.sky * (1 - up) + self.sky_zenith * up)
+            self._skies[id(rays)] = (rays, sky)        # the rays kept: their id stays theirs
+        return self._skies[id(rays)][1]
+
     def _image(self, pose, camera_height: float, rays: Rays, k: int, spacing: float,
                lighting: Lighting | None) -> np.ndarray:
         x, y, yaw = (float(v) for v in pose)
@@ -247,7 +266,7 @@ class RayCaster:
         shadow = self._shadow_map(light) if self.shadows else _NO_SHADOWS
         shade(hit, weights, self._lit(light, origin, drawn), self._texture,
               self._uvs, self._atlas, self._levels, self._first_level, self._texel_density,
-              self._tris, self._normals, origin, spacing, self.sky, image,
+              self._tris, self._normals, origin, spacing, self._sky(rays), image,
               self.mesh.colors * light.ambient if self.shadows else self.mesh.colors,
               shadow.depth, shadow.axes, shadow.origin, shadow.cell)
         return photometric(image, lighting)

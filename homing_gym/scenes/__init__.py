@@ -15,6 +15,7 @@ import numpy as np
 from homing_gym.scenes.arena import arena_scene
 from homing_gym.scenes.base import SHAPES, Landmark, Scene, Wall, square_walls
 from homing_gym.scenes.corridors import corridors_scene
+from homing_gym.scenes.families import FAMILIES
 from homing_gym.scenes.hallway import hallway_scene
 from homing_gym.scenes.house import house_scene
 from homing_gym.scenes.lab import lab_scene
@@ -98,6 +99,12 @@ register_scene("random_nature", SceneFactory(
     build=random_nature_scene, randomised=True,
     description="procedural outdoor world per episode: open ground, trees, rocks, bushes, "
                 "distant hills, fenced 6-10 m square"))
+
+for _family in FAMILIES.values():          # the world families not registered above
+    if _family.name not in _SCENES:
+        register_scene(_family.name, SceneFactory(
+            build=lambda rng, f=_family: f.build(rng), randomised=True,
+            description=f"world family ({_family.kind}): {_family.description}"))
 
 __all__ = ["MESH_PREFIX", "SHAPES", "Landmark", "MeshPart", "MeshScene", "Scene",
            "SceneFactory", "Wall", "available_scenes", "register_scene", "scene_factory",

@@ -15,6 +15,7 @@ from weakref import WeakKeyDictionary
 
 import numpy as np
 
+from homing_gym.scenes.appearance import PLAIN, Appearance
 from homing_gym.scenes.footprint import ClearanceField, clearance_field
 from homing_gym.scenes.mesh_part import MeshPart, check_face_count
 from homing_gym.scenes.textures import check_texture
@@ -136,7 +137,10 @@ class Scene:
     them keep it there (for worlds without walls). ``ground_plane``: draw the floor
     (``floor_color``/``floor_texture``; the robot always drives on the plane z = 0).
     ``sky_color``: RGB in [0, 1] that the ray caster shows where rays hit nothing (the
-    env's ``sky_color`` argument overrides it). ``height_band``: see :data:`HEIGHT_BAND`."""
+    env's ``sky_color`` argument overrides it); the colour at the horizon when
+    ``appearance`` gives a zenith colour. ``appearance``: the world's sky gradient,
+    light, shadows and camera height (:class:`~homing_gym.scenes.appearance.Appearance`;
+    the env's arguments override it). ``height_band``: see :data:`HEIGHT_BAND`."""
 
     name: str
     bounds: tuple[tuple[float, float], tuple[float, float]]
@@ -149,6 +153,7 @@ class Scene:
     ground_plane: bool = True
     sky_color: tuple[float, float, float] | None = None
     height_band: tuple[float, float] = HEIGHT_BAND
+    appearance: Appearance = PLAIN
     metadata: dict = field(default_factory=dict, compare=False, hash=False)
 
     def __post_init__(self) -> None:
@@ -175,6 +180,9 @@ class Scene:
                              f"with 0 <= low < high, got {self.height_band!r}")
         if self.sky_color is not None:
             _check_color(f"scene {self.name!r} sky", (*self.sky_color, 1.0))
+        if not isinstance(self.appearance, Appearance):
+            raise ValueError(f"scene {self.name!r}: appearance must be an Appearance, got "
+                             f"{type(self.appearance).__name__}")
         for lm in self.landmarks:
             x, y = lm.position
             hx, hy = lm.footprint_half_size

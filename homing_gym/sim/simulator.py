@@ -61,7 +61,8 @@ class Simulator:
 
     def __init__(self, scene: Scene, *, gui: bool = False, time_step: float = 1 / 120,
                  robot_config: RobotConfig = RobotConfig(), renderer: str = "raycast",
-                 sky_color: tuple[float, float, float] | None = None, shadows: bool = False,
+                 sky_color: tuple[float, float, float] | None = None,
+                 shadows: bool | None = None,
                  motion: str = "pybullet"):
         with native_output_captured():    # the C++ core prints "argv[0]=" on connecting
             self.client = BulletClient(connection_mode=p.GUI if gui else p.DIRECT)
@@ -72,7 +73,7 @@ class Simulator:
         self._sky_color = sky_color
         #: The ray caster of the current world (``renderer="raycast"``), else None.
         self._shadows = shadows
-        self.caster = (world_caster(scene, self.sky(scene), shadows)
+        self.caster = (world_caster(scene, sky_color, shadows)
                        if renderer == "raycast" else None)
         self.time_step = time_step
         self._vertices, self._vertices_of = np.zeros((0, 3)), None   # world_vertices' cache
@@ -221,7 +222,7 @@ class Simulator:
         self.client.resetSimulation()
         self._build(scene)
         if self.caster is not None:
-            self.caster = caster or world_caster(scene, self.sky(scene), self._shadows)
+            self.caster = caster or world_caster(scene, self._sky_color, self._shadows)
 
     def world_vertices(self) -> np.ndarray:
         """The distinct corners ``(V, 3)`` (metres) of the current world's triangles
@@ -230,10 +231,6 @@ class Simulator:
             corners = world_mesh(self.scene).triangles.reshape(-1, 3).astype(np.float64)
             self._vertices, self._vertices_of = np.unique(corners, axis=0), self.scene
         return self._vertices
-
-    def sky(self, scene: Scene) -> tuple[float, float, float]:
-        """The ray caster's sky in ``scene`` (:func:`world_sky`)."""
-        return world_sky(scene, self._sky_color)
 
     def place_robot(self, pose, clear_contacts: bool = False) -> None:
         """Teleport the robot to ``pose`` (x, y, yaw; metres, radians). With
@@ -280,15 +277,28 @@ class Simulator:
         return self._connected
 
 
-def world_sky(scene: Scene, sky_color=None) -> tuple[float, float, float]:
-    """The ray caster's sky: the env's ``sky_color``, else the scene's, else white."""
-    return tuple(sky_color or scene.sky_color or SKY_COLOR)
+def world_sky(scene: Scene, sky_color=None) -> tuple[tuple[float, float, float],
+                                                     tuple[float, float, float] | None]:
+    """The ray caster's sky, ``(horizon, zenith)``: the env's ``sky_color`` (uniform: no
+    zenith colour), else the scene's ``sky_color`` (else white) with its appearance's
+    ``sky_zenith``."""
+    if sky_color:
+        return tuple(sky_color), None
+    return tuple(scene.sky_color or SKY_COLOR), scene.appearance.sky_zenith
 
 
-def world_caster(scene: Scene, sky: tuple[float, float, float], shadows: bool) -> RayCaster:
-    """The ray caster of ``scene``'s world mesh under ``sky`` (what a simulator with
-    ``renderer="raycast"`` draws with)."""
-    return RayCaster(world_mesh(scene), sky, shadows)
+def world_shadows(scene: Scene, shadows: bool | None = None) -> bool:
+    """Whether the world casts shadows: the env's ``shadows`` if given (not ``None``),
+    else the scene's appearance's, else not."""
+    return bool(scene.appearance.shadows) if shadows is None else shadows
+
+
+def world_caster(scene: Scene, sky_color=None, shadows: bool | None = None) -> RayCaster:
+    """The ray caster of ``scene``'s world mesh (what a simulator with
+    ``renderer="raycast"`` draws with) under the env's ``sky_color`` and ``shadows``
+    (``None``: the world's; :func:`world_sky`, :func:`world_shadows`)."""
+    horizon, zenith = world_sky(scene, sky_color)
+    return RayCaster(world_mesh(scene), horizon, world_shadows(scene, shadows), zenith)
 
 
 def _face_chunks(vertices: np.ndarray, faces: np.ndarray) -> list[np.ndarray]:

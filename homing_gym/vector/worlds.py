@@ -22,7 +22,7 @@ import numpy as np
 from homing_gym.render.raycast import RayCaster
 from homing_gym.scenes import scene_factory
 from homing_gym.scenes.base import Scene
-from homing_gym.sim.simulator import world_caster, world_sky
+from homing_gym.sim.simulator import world_caster
 
 #: Seconds a closing builder may take before it is killed.
 CLOSE_TIMEOUT = 5.0
@@ -35,10 +35,10 @@ def next_child(stream: np.random.SeedSequence) -> np.random.SeedSequence:
                                   pool_size=stream.pool_size)
 
 
-def _build(scene: str, sky_color, shadows: bool,
+def _build(scene: str, sky_color, shadows: bool | None,
            seeds: np.random.SeedSequence) -> tuple[Scene, RayCaster]:
     world = scene_factory(scene).build(np.random.default_rng(seeds))
-    return world, world_caster(world, world_sky(world, sky_color), shadows)
+    return world, world_caster(world, sky_color, shadows)
 
 
 def _serve(conn) -> None:
@@ -94,7 +94,7 @@ class WorldBuilder:
             self.alive = False
             self._ready.notify_all()
 
-    def source(self, scene: str, sky_color, shadows: bool) -> "BuiltWorlds":
+    def source(self, scene: str, sky_color, shadows: bool | None) -> "BuiltWorlds":
         """The :class:`~homing_gym.env.WorldSource` of one env whose scene is ``scene``."""
         return BuiltWorlds(self, (scene, sky_color, shadows))
 
