@@ -429,8 +429,12 @@ class HomingEnv(gym.Env):
         self._use_appearance()
         if self.world_source is not None and self._scene_factory.randomised:
             self.world_source.ahead(self._world_seeds)
-        self.episode = self._episode_with_options(
-            self.task.sample_episode(self.scene, self.np_random), options or {})
+        try:
+            episode = self.task.sample_episode(self.scene, self.np_random)
+        except ValueError as error:          # say which world: a procedural one is its seed's
+            raise ValueError(f"{error} (world drawn by reset(seed={seed!r}))"
+                             if self.draws_worlds else str(error)) from error
+        self.episode = self._episode_with_options(episode, options or {})
         # the ray caster never sees the robot's body, so it takes the snapshot of each
         # later goal (a route's targets) when that goal becomes current, without moving
         # the robot: a route of thousands of targets resets at the cost of one

@@ -27,23 +27,26 @@ from homing_gym.outputs import output_dir_argument
 PANORAMA = (60, 360)
 
 
-def world_row(scene: str, seed: int, size: int = 240) -> np.ndarray:
-    """The map of episode ``seed``'s world beside both renderers' start panoramas."""
-    views = {}
-    for renderer in ("raycast", "tiny"):
+def world_row(scene: str, seed: int, size: int = 240,
+              renderers: tuple[str, ...] = ("raycast", "tiny")) -> np.ndarray:
+    """The map of episode ``seed``'s world beside each renderer's start panorama (the
+    first labelled with the seed and the camera's height)."""
+    views, labels = {}, {}
+    for renderer in renderers:
         env = gym.make("homing_gym/LocalHoming-v0", scene=scene, renderer=renderer,
                        panorama_shape=PANORAMA)
         env.reset(seed=seed)
         u = env.unwrapped
         views[renderer] = u.render_panorama(u.pose)
-        world, pose = u.scene, u.pose.copy()
+        labels[renderer] = renderer
+        world, pose, height = u.scene, u.pose.copy(), u.camera.camera_height
         env.close()
+    labels[renderers[0]] = f"seed {seed}: {renderers[0]}, camera {100 * height:.0f} cm up"
     canvas = MapCanvas(world, size)
     top = draw_scene(world, canvas)
     draw_pose(top, canvas, pose, 0.16, ROBOT)
     draw_scale_bar(top, canvas, 1.0)
-    right = np.concatenate([labelled(views["raycast"], f"seed {seed}: raycast", 2 * size),
-                            labelled(views["tiny"], "tiny", 2 * size)])
+    right = np.concatenate([labelled(views[r], labels[r], 2 * size) for r in renderers])
     height = max(size, right.shape[0])
     return np.concatenate([_pad(top, height), _pad(right, height)], axis=1)
 

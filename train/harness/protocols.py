@@ -33,6 +33,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from homing_gym.scenes import scene_factory
+from homing_gym.scenes.families import families_in
 from homing_gym.scenes.base import clearance
 
 #: The renderer and physics every version-1 protocol was measured with (homing-gym 0.1's
@@ -239,6 +240,12 @@ UNSEEN_SEED = 10_000_000
 #: ``local-common``'s seeds (v3): clear of every training seed (a training env ``i``
 #: starts in the world of seed ``seed + i``) and of ``unseen``'s.
 COMMON_SEED = 20_000_000
+#: ``unseen-families``' seeds: the test families are held out whole, so any seed would
+#: do; these are clear of every other protocol's.
+FAMILIES_SEED = 30_000_000
+#: Every classical method that runs LocalHoming from pixels alone, and the policies.
+FAMILY_METHODS = ("oracle", "random", "snapshot", "warping", "min-warping", "distance", "alv",
+                  "did", POLICIES)
 #: The worlds of ``local-common`` v2: the paper scenes and the procedural worlds.
 COMMON_SCENES = ("arena", "hallway", "lab", "house", "random_rooms", "random_nature")
 PROCEDURAL = ("random_arena", "random_rooms", "random_nature")
@@ -248,6 +255,12 @@ def _held_out(episodes: int, seed: int) -> list[Task]:
     """Seeds from :data:`UNSEEN_SEED` on: procedural worlds no policy trained on, and
     homes and starts that no other protocol draws."""
     return [(UNSEEN_SEED + seed + i, None, None) for i in range(episodes)]
+
+
+def _families(episodes: int, seed: int) -> list[Task]:
+    """Seeds from :data:`FAMILIES_SEED` on: worlds of the test families (no training
+    or selection run draws from them at all)."""
+    return [(FAMILIES_SEED + seed + i, None, None) for i in range(episodes)]
 
 
 def _common(episodes: int, seed: int) -> list[Task]:
@@ -375,6 +388,16 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
         tuple(Setting(f"{scene} (held out)", LOCAL, {"scene": scene}, _held_out, V2_SIMULATION)
               for scene in (*PROCEDURAL, "hallway", "lab", "house")),
         HOMING_METHODS, episodes=5),
+    Protocol(
+        "unseen-families", 1, "whole world families that no shipped policy or recipe "
+        "trains or selects on (:data:`~homing_gym.scenes.families.FAMILIES`, role "
+        f"'test'): {', '.join(families_in('test'))}, one setting each (weighted equally), "
+        "every world with its own sky, light, shadows and camera height (0.02-0.5 m); "
+        f"homes anywhere, starts 0.3-2.0 m, seeds from {FAMILIES_SEED}; ray cast, 1/120 s "
+        "physics",
+        tuple(Setting(name, LOCAL, {"scene": name, "start_distance": [0.3, 2.0]}, _families,
+                      V2_SIMULATION) for name in families_in("test")),
+        FAMILY_METHODS, episodes=100),
 )}
 
 
