@@ -28,6 +28,7 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass, field, replace
+from functools import partial
 from typing import Callable, Sequence
 
 import numpy as np
@@ -257,10 +258,12 @@ def _held_out(episodes: int, seed: int) -> list[Task]:
     return [(UNSEEN_SEED + seed + i, None, None) for i in range(episodes)]
 
 
-def _families(episodes: int, seed: int) -> list[Task]:
-    """Seeds from :data:`FAMILIES_SEED` on: worlds of the test families (no training
-    or selection run draws from them at all)."""
-    return [(FAMILIES_SEED + seed + i, None, None) for i in range(episodes)]
+def _family_seeds(k: int, episodes: int, seed: int) -> list[Task]:
+    """Seeds from :data:`FAMILIES_SEED` on for the ``k``-th test family, a million apart
+    from the next family's (the same seed draws the same sky, light and camera height in
+    every family: each family gets its own)."""
+    first = FAMILIES_SEED + 1_000_000 * k + seed
+    return [(first + i, None, None) for i in range(episodes)]
 
 
 def _common(episodes: int, seed: int) -> list[Task]:
@@ -393,10 +396,12 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
         "trains or selects on (:data:`~homing_gym.scenes.families.FAMILIES`, role "
         f"'test'): {', '.join(families_in('test'))}, one setting each (weighted equally), "
         "every world with its own sky, light, shadows and camera height (0.02-0.5 m); "
-        f"homes anywhere, starts 0.3-2.0 m, seeds from {FAMILIES_SEED}; ray cast, 1/120 s "
+        f"homes anywhere, starts 0.3-2.0 m, seeds from {FAMILIES_SEED} (a million apart per "
+        "family); ray cast, 1/120 s "
         "physics",
-        tuple(Setting(name, LOCAL, {"scene": name, "start_distance": [0.3, 2.0]}, _families,
-                      V2_SIMULATION) for name in families_in("test")),
+        tuple(Setting(name, LOCAL, {"scene": name, "start_distance": [0.3, 2.0]},
+                      partial(_family_seeds, k), V2_SIMULATION)
+              for k, name in enumerate(families_in("test"))),
         FAMILY_METHODS, episodes=100),
 )}
 
