@@ -36,6 +36,7 @@ from homing_gym.scenes.base import Scene
 from homing_gym.scenes.families.built_parts import (box_mesh, floor_quad, prism_mesh,
                                                     quads_part, scaled, solids_part,
                                                     texture_color, tinted)
+from homing_gym.scenes.mesh_part import MeshPart
 from homing_gym.scenes.random_nature import GROUND_RADIUS, _lump, _unit_ball
 
 #: Least gap (metres) between two footprints on the free floor, and between a footprint
@@ -381,15 +382,17 @@ def _far_blocks(rng: np.random.Generator, near: list[Rect], open_area: Rect) -> 
     return blocks
 
 
-def _ground(texture: np.ndarray, tile: float):
-    """The paving: a 24-sided disc of :data:`GROUND_RADIUS`, textured ``tile`` metres
-    per repeat."""
-    a = np.linspace(0, 2 * math.pi, 25)
-    rim = GROUND_RADIUS * np.stack([np.cos(a), np.sin(a)], 1)
-    quads = [[(0.0, 0.0, 0.0), (*rim[k], 0.0), (*rim[k + 1], 0.0), (0.0, 0.0, 0.0)]
-             for k in range(24)]
-    quads = np.array(quads)
-    return quads_part(quads, "ground", texture=texture, uvs=quads[..., :2] / tile)
+def _ground(texture: np.ndarray, tile: float) -> MeshPart:
+    """The paving: a 24-sided disc of :data:`GROUND_RADIUS` (a fan of triangles),
+    textured ``tile`` metres per repeat; an open surface."""
+    a = np.linspace(0, 2 * math.pi, 24, endpoint=False)
+    vertices = np.concatenate([[[0.0, 0.0, 0.0]], GROUND_RADIUS * np.stack(
+        [np.cos(a), np.sin(a), np.zeros(24)], 1)])
+    k = np.arange(24)
+    faces = np.stack([np.zeros(24, int), 1 + k, 1 + (k + 1) % 24], 1)
+    return MeshPart(vertices, faces, np.broadcast_to(texture_color(texture), (24, 3)),
+                    uvs=vertices[:, :2] / tile, texture=texture, collision=False, name="ground",
+                    solid_faces=())
 
 
 def _paving(rng: np.random.Generator) -> tuple[np.ndarray, float]:
