@@ -34,8 +34,10 @@ RGB = tuple[float, float, float]
 ROBOT_CLEARANCE = 0.22
 #: Least width (metres) of the aisles that join every part of the floor.
 AISLE = 0.6
-#: Floor plan cell (metres).
+#: Spacing (metres) of the floor plan's grid: that of the task's paths
+#: (:data:`homing_gym.paths.RESOLUTION`).
 CELL = 0.05
+#: Textures of posters and pictures (tinted).
 POSTER_TEXTURES = ("poster_a", "poster_b", "stripes_warm", "stripes_cool", "checker_green",
                    "bricks_red", "wood_light")
 #: Neighbours that join grid points into regions (as :func:`homing_gym.paths.regions`).
@@ -48,7 +50,7 @@ PANEL_DEPTH, OFF_WALL = 0.021, 0.03
 #: round things are polygons inside the plan's discs.
 MARGIN = 0.03
 #: The clearances (metres) at which the floor plan must stay one region: every one
-#: within :data:`MARGIN` of :data:`ROBOT_CLEARANCE` (1 cm apart), so that no narrow way
+#: within :data:`MARGIN` of :data:`ROBOT_CLEARANCE` (2 cm apart), so that no narrow way
 #: into a pocket or along a closed channel is left whose width the plan may misjudge;
 #: and :data:`AISLE` / 2 + :data:`MARGIN`, the one most pieces fail at, first.
 _RADII = (AISLE / 2 + MARGIN,
@@ -206,16 +208,12 @@ class Furnishing:
         """Add ``piece`` if the plan accepts it (:meth:`FloorPlan.place`)."""
         if not self.plan.place(piece.footprint, piece.blocking):
             return False
-        self.add(piece)
-        return True
-
-    def add(self, piece: Piece) -> None:
-        """Add ``piece`` without asking the plan (things standing on placed furniture)."""
         for name, mesh, rgb in piece.solids:
             meshes, colors = self._solids[name]
             meshes.append(mesh)
             colors.append(np.clip(np.asarray(rgb, np.float64), 0, 1))
         self.landmarks += piece.landmarks
+        return True
 
     def parts(self) -> tuple[MeshPart, ...]:
         """The gathered solids, one :class:`MeshPart` per part name that has any."""
@@ -303,15 +301,17 @@ def ring(rect: Rect, width: float, z0: float, z1: float) -> Mesh:
 def table(rect: Rect, height: float, top: RGB, frame: RGB, panel_ends: bool = False,
           shelf: float | None = None) -> Piece:
     """A desk or table over ``rect``, ``height`` metres high: a 3 cm top, four legs (or,
-    with ``panel_ends``, two end panels along its y sides) on a floor frame ring, and
+    with ``panel_ends``, a panel across each short end) on a floor frame ring, and
     optionally a lower shelf ``shelf`` metres up. It blocks the robot over its whole
     footprint."""
     base = grown(rect, -0.03)
     x0, y0, x1, y1 = base
     solids = [("furniture", box(rect, height - 0.03, height), top),
               ("furniture", ring(base, 0.04, 0.0, 0.06), frame)]
-    if panel_ends:
+    if panel_ends and x1 - x0 >= y1 - y0:
         legs = [(x0, y0, x0 + 0.03, y1), (x1 - 0.03, y0, x1, y1)]
+    elif panel_ends:
+        legs = [(x0, y0, x1, y0 + 0.03), (x0, y1 - 0.03, x1, y1)]
     else:
         legs = [square((x, y), 0.025) for x in (x0 + 0.025, x1 - 0.025)
                 for y in (y0 + 0.025, y1 - 0.025)]
