@@ -5,7 +5,9 @@ writes ``DIR/unseen/<method>/``).
 ``python -m homing_train.figures.generalisation --cells DIR/unseen --out docs/generalisation``
 writes ``per_scene.png`` (success with the protocol's stop rule per scene, one bar per
 method in its fixed colour, Wilson 95 % intervals, episodes per bar in the legend),
-``per_scene.md`` (the same as a table) and ``failures.png`` (for each method that failed
+``per_scene.md`` (the same as a table, with a column over all scenes),
+``by_distance.png`` (success against the start's distance from home, every scene's
+episodes together) and ``failures.png`` (for each method that failed
 at all, its failed episode of the lowest seed in each scene seen from above, labelled
 with its final distance: the world rebuilt from the episode's seed, the path in orange,
 home in green with the success circle, the end in blue, 1 m scale bar). Nothing is run but the worlds' construction; the episodes come from the folder.
@@ -29,7 +31,7 @@ from homing_gym.cli import command_parser
 from homing_gym.render.topdown import BG, MapCanvas, draw_scale_bar, draw_topdown, labelled
 from homing_train.harness.evaluate import EpisodeRecord, EvalResult
 from homing_train.harness.matrix import setting_stem
-from homing_train.harness.metrics import wilson_interval
+from homing_train.harness.metrics import distance_bins, wilson_interval
 from homing_train.harness.palette import method_color
 from homing_gym.outputs import output_dir_argument, save_figure
 
@@ -70,44 +72,50 @@ def load_results(cells: Path) -> dict[str, list[SceneResult]]:
     return found
 
 
+def _rate(successes: int, n: int) -> str:
+    """``success % [Wilson 95 % interval] (n)``."""
+    lo, hi = wilson_interval(successes, n)
+    return f"{100 * successes / n:.0f} [{100 * lo:.0f}, {100 * hi:.0f}] ({n})"
+
+
 def per_scene_markdown(results: dict[str, list[SceneResult]]) -> str:
-    """Success % [Wilson 95 % interval] (episodes) per method and scene."""
+    """Success % [Wilson 95 % interval] (episodes) per method and scene, and over all
+    scenes (every episode counted once: the scenes weigh as their episode counts)."""
     labels = [r.label for r in next(iter(results.values()))]
-    lines = ["| method | " + " | ".join(labels) + " |", "|---|" + "---:|" * len(labels)]
+    lines = ["| method | " + " | ".join(labels) + " | all |",
+             "|---|" + "---:|" * (len(labels) + 1)]
     for method, rows in results.items():
-        cells = []
-        for r in rows:
-            lo, hi = wilson_interval(r.successes, len(r.episodes))
-            cells.append(f"{100 * r.successes / len(r.episodes):.0f} [{100 * lo:.0f}, "
-                         f"{100 * hi:.0f}] ({len(r.episodes)})")
+        cells = [_rate(r.successes, len(r.episodes)) for r in rows]
+        cells.append(_rate(sum(r.successes for r in rows), sum(len(r.episodes) for r in rows)))
         lines.append(f"| {method} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
-def per_scene_figure(results: dict[str, list[SceneResult]], path: Path) -> None:
-    """Grouped bars: success % per scene, one bar per method, Wilson 95 % intervals."""
+def by_distance_figure(results: dict[str, list[SceneResult]], path: Path,
+                       width: float = 0.3) -> None:
+    """Success % against the start's distance from home in ``width`` metre bins
+    (:func:`~homing_train.harness.metrics.distance_bins`; every scene's episodes
+    together), one line per method in its fixed colour, Wilson 95 % intervals as bands."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    labels = [_scene(r.label) for r in next(iter(results.values()))]
-    counts = sorted({len(r.episodes) for rows in results.values() for r in rows})
-    width = 0.8 / len(results)
-    fig, ax = plt.subplots(figsize=(max(7.0, 1.9 * len(labels)), 3.8), dpi=150)
-    for k, (method, rows) in enumerate(results.items()):
-        x = np.arange(len(rows)) + (k - (len(results) - 1) / 2) * width
-        rate = np.array([r.successes / len(r.episodes) for r in rows])
-        ci = np.array([wilson_interval(r.successes, len(r.episodes)) for r in rows])
-        ax.bar(x, 100 * rate, width, color=method_color(method), label=method)
-        ax.errorbar(x, 100 * rate, yerr=100 * np.abs(ci.T - rate), fmt="none",
-                    ecolor="0.25", elinewidth=0.8, capsize=1.5)
-    ax.set_xticks(np.arange(len(labels)), labels)
+    fig, ax = plt.subplots(figsize=(6.5, 3.6), dpi=150)
+    for method, rows in results.items():
+        episodes = [e for r in rows for e in r.episodes]
+        bins = distance_bins([e.start_distance for e in episodes],
+                             [e.success for e in episodes], width)
+        x = [(b.lo + b.hi) / 2 for b in bins]
+        color = method_color(method)
+        ax.plot(x, [100 * b.success_rate for b in bins], "-o", ms=3, color=color,
+                label=method)
+        ax.fill_between(x, [100 * b.success_ci[0] for b in bins],
+                        [100 * b.success_ci[1] for b in bins], color=color, alpha=0.12)
+    ax.set_xlabel("start distance from home (m)")
     ax.set_ylabel("success % (stopped within radius)")
     ax.set_ylim(0, 100)
-    ax.set_title(f"{'/'.join(map(str, counts))} episodes per bar, Wilson 95 % intervals",
-                 fontsize=8)
-    ax.legend(fontsize=7, ncol=(len(results) + 1) // 2, loc="upper center",
-              bbox_to_anchor=(0.5, -0.1), frameon=False)
+    ax.set_title(f"all settings together, {width:g} m bins, Wilson 95 % intervals", fontsize=8)
+    ax.legend(fontsize=7, ncol=2, frameon=False, loc="upper right")
     ax.spines[["top", "right"]].set_visible(False)
     fig.tight_layout()
     save_figure(fig, path, bbox_inches="tight")
@@ -182,8 +190,9 @@ def main(argv: list[str] | None = None) -> int:
     out.mkdir(parents=True, exist_ok=True)
     (out / "per_scene.md").write_text(per_scene_markdown(results) + "\n")
     per_scene_figure(results, out / "per_scene.png")
+    by_distance_figure(results, out / "by_distance.png")
     failures_figure(results, out / "failures.png")
-    print(f"wrote {out}/per_scene.md, per_scene.png, failures.png")
+    print(f"wrote {out}/per_scene.md, per_scene.png, by_distance.png, failures.png")
     return 0
 
 

@@ -43,8 +43,9 @@ def test_per_scene_table_counts_successes_with_wilson_intervals(tmp_path):
     assert [r.label for r in results["warping"]] == ["arena (held out)", "lab (held out)"]
     table = per_scene_markdown(results).splitlines()
     # 1 of 2: Wilson 95 % = 0.5 +- 1.96 sqrt(0.125 + 0.2401) / 2.9208 = [0.09, 0.91]
-    assert "| warping | 50 [9, 91] (2) | 100 [34, 100] (2) |" in table
-    assert "| snapshot | 0 [0, 66] (2) | 50 [9, 91] (2) |" in table
+    # over both scenes: 3 of 4 -> (0.75 + 0.4802) / 1.9604 +- 1.96 * 0.32696 / 1.9604
+    assert "| warping | 50 [9, 91] (2) | 100 [34, 100] (2) | 75 [30, 95] (4) |" in table
+    assert "| snapshot | 0 [0, 66] (2) | 50 [9, 91] (2) | 25 [5, 70] (4) |" in table
 
 
 def test_failures_figure_has_a_row_per_method_that_failed(tmp_path):
