@@ -97,9 +97,10 @@ def _tree(rng: np.random.Generator, xy) -> tuple[list, list]:
     return [(trunk, trunk_faces), (crown, faces)], [bark, leaves]
 
 
-def _ground(rng: np.random.Generator) -> MeshPart:
-    """A disc of :data:`GROUND_RADIUS`: rings growing outwards, faces in varied greens and
-    browns."""
+@lru_cache(maxsize=1)
+def _disc() -> tuple[np.ndarray, np.ndarray]:
+    """Vertices and faces of a flat disc of :data:`GROUND_RADIUS`: 14 rings growing
+    outwards from 0.5 m, 36 sectors (made once)."""
     radii = np.concatenate([[0.0], np.geomspace(0.5, GROUND_RADIUS, 14)])
     sectors = 36
     a = np.linspace(0, 2 * math.pi, sectors, endpoint=False)
@@ -111,10 +112,19 @@ def _ground(rng: np.random.Generator) -> MeshPart:
         for k in range(sectors):
             k1 = (k + 1) % sectors
             faces += [[inner + k, outer + k, outer + k1], [inner + k, outer + k1, inner + k1]]
+    faces = np.array(faces)
+    vertices.flags.writeable = faces.flags.writeable = False
+    return vertices, faces
+
+
+def _ground(rng: np.random.Generator) -> MeshPart:
+    """A disc of :data:`GROUND_RADIUS` (:func:`_disc`), faces in varied greens and
+    browns."""
+    vertices, faces = _disc()
     base = np.array([rng.uniform(0.25, 0.45), rng.uniform(0.4, 0.6), rng.uniform(0.15, 0.3)])
     colors = base * rng.uniform(0.75, 1.25, (len(faces), 1)) + rng.uniform(-0.05, 0.05,
                                                                            (len(faces), 3))
-    return MeshPart(vertices, np.array(faces), np.clip(colors, 0, 1), collision=False,
+    return MeshPart(vertices, faces, np.clip(colors, 0, 1), collision=False,
                     name="ground", solid_faces=())           # an open surface
 
 

@@ -29,11 +29,13 @@ def test_test_families_are_natural_built_and_indoor_and_never_train():
 
 
 def _same_world(a: Scene, b: Scene) -> bool:
-    """Equal scenes, mesh parts compared by their arrays (MeshPart compares by identity)."""
+    """Equal scenes, mesh parts compared by their names and arrays, textures included
+    (MeshPart compares by identity)."""
     plain = dataclasses.replace(a, meshes=()) == dataclasses.replace(b, meshes=())
     return plain and len(a.meshes) == len(b.meshes) and all(
-        np.array_equal(getattr(m, k), getattr(n, k))
-        for m, n in zip(a.meshes, b.meshes) for k in ("vertices", "faces", "face_colors"))
+        m.name == n.name and np.array_equal(getattr(m, k), getattr(n, k))
+        for m, n in zip(a.meshes, b.meshes)
+        for k in ("vertices", "faces", "face_colors", "uvs", "texture"))
 
 
 @pytest.mark.parametrize("name", NEW)

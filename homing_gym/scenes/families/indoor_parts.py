@@ -440,6 +440,14 @@ def outer_walls(bounds, thickness: float, height: float, finishes: list[dict]) -
                  **finishes[k]) for k in range(4)]
 
 
+def wall_finishes(rng: np.random.Generator, paint: dict, keep: float,
+                  textures: tuple[str, ...], **other) -> list[dict]:
+    """Finishes of the four outer walls (for :func:`outer_walls`): each the room's
+    ``paint`` with probability ``keep``, otherwise a :func:`finish` of its own from
+    ``textures`` (``other``: its other arguments)."""
+    return [paint if rng.random() < keep else finish(rng, textures, **other) for _ in range(4)]
+
+
 def wall_panel(wall: Wall, side: float, s: float, width: float, height: float, base: float,
                color, texture: str | None, name: str) -> Landmark:
     """A panel (window, poster, board) ``width`` x ``height`` metres, ``base`` metres up,
@@ -523,4 +531,16 @@ def decor(rng: np.random.Generator, wall: Wall, side: float, start: float, end: 
             continue
         used.append((s, width))
         panels.append(wall_panel(wall, side, s, width, high, base, color, texture, name))
+    return panels
+
+
+def wall_decor(rng: np.random.Generator, walls: list[Wall], skip) -> list[Landmark]:
+    """Up to 1-3 posters, pictures and whiteboards (:func:`decor`) on the inner face of
+    each of the four outer ``walls`` but those of sides ``skip`` (e.g. the windowed ones)."""
+    panels = []
+    for side in range(4):
+        if side not in skip:
+            wall = walls[side]
+            panels += decor(rng, wall, 1.0, wall.thickness / 2,
+                            wall.length - wall.thickness / 2, int(rng.integers(1, 4)))
     return panels

@@ -34,8 +34,8 @@ from homing_gym.scenes.appearance import random_appearance
 from homing_gym.scenes.base import Landmark, Scene
 from homing_gym.scenes.families.indoor_parts import (
     Capsule, FloorPlan, Furnishing, Piece, Rect, against_wall, box, box_landmark, cart,
-    cylinder, decor, finish, grown, outer_walls, shade, shelving, stool, table, wall_length,
-    windows)
+    cylinder, finish, grown, outer_walls, shade, shelving, stool, table, wall_decor,
+    wall_finishes, wall_length, windows)
 
 WALL_TEXTURES = ("floor_tiles", "concrete", "bricks_grey", "checker_green")
 FLOOR_TEXTURES = ("floor_tiles", "concrete", "checker_dark")
@@ -374,10 +374,8 @@ def labs_scene(rng: np.random.Generator) -> Scene:
     bounds = ((-width / 2, -depth / 2), (width / 2, depth / 2))
     height, thickness = float(rng.uniform(2.0, 3.0)), float(rng.uniform(0.1, 0.25))
     paint = finish(rng, WALL_TEXTURES, plain=0.55, low=0.7, high=0.95, hue=0.05)
-    finishes = [paint if rng.random() < 0.8
-                else finish(rng, WALL_TEXTURES, plain=0.5, low=0.55, high=0.9, hue=0.1)
-                for _ in range(4)]
-    walls = outer_walls(bounds, thickness, height, finishes)
+    walls = outer_walls(bounds, thickness, height, wall_finishes(
+        rng, paint, 0.8, WALL_TEXTURES, plain=0.5, low=0.55, high=0.9, hue=0.1))
     floor = finish(rng, FLOOR_TEXTURES, plain=0.35, low=0.3, high=0.65, hue=0.06, tint=0.45)
     style = {
         "casework": finish(rng, CASEWORK_TEXTURES, plain=0.6, low=0.55, high=0.95, hue=0.12),
@@ -391,11 +389,7 @@ def labs_scene(rng: np.random.Generator) -> Scene:
     _along_walls(rng, bounds, height, lab, style)
     islands = _islands(rng, bounds, height, lab, style)
     boxes = _floor_clutter(rng, bounds, lab, style)
-    for side in range(4):
-        if side not in window_sides:
-            wall = walls[side]
-            lab.landmarks += decor(rng, wall, 1.0, wall.thickness / 2,
-                                   wall.length - wall.thickness / 2, int(rng.integers(1, 4)))
+    lab.landmarks += wall_decor(rng, walls, skip=window_sides)
     return Scene(name="labs", bounds=bounds, walls=tuple(walls), landmarks=tuple(lab.landmarks),
                  floor_color=floor["color"], floor_texture=floor["texture"], meshes=lab.parts(),
                  sky_color=horizon, appearance=appearance,

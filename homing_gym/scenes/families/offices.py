@@ -34,8 +34,8 @@ from homing_gym.scenes.appearance import random_appearance
 from homing_gym.scenes.base import Landmark, Scene, Wall
 from homing_gym.scenes.families.indoor_parts import (
     Capsule, FloorPlan, Furnishing, Piece, Rect, against_wall, box, box_landmark, cylinder,
-    decor, finish, grown, office_chair, outer_walls, potted_plant, shade, table, wall_length,
-    windows)
+    decor, finish, grown, office_chair, outer_walls, potted_plant, shade, table, wall_decor,
+    wall_finishes, wall_length, windows)
 
 WALL_TEXTURES = ("concrete", "bricks_grey", "bricks_red", "wood_light", "stripes_cool",
                  "checker_green")
@@ -350,10 +350,8 @@ def offices_scene(rng: np.random.Generator) -> Scene:
     bounds = ((-width / 2, -depth / 2), (width / 2, depth / 2))
     height, thickness = float(rng.uniform(2.0, 3.0)), float(rng.uniform(0.1, 0.25))
     paint = finish(rng, WALL_TEXTURES, plain=0.6, low=0.75, high=0.95)
-    finishes = [paint if rng.random() < 0.75
-                else finish(rng, WALL_TEXTURES, plain=0.4, low=0.5, high=0.9, hue=0.15)
-                for _ in range(4)]
-    walls = outer_walls(bounds, thickness, height, finishes)
+    walls = outer_walls(bounds, thickness, height, wall_finishes(
+        rng, paint, 0.75, WALL_TEXTURES, plain=0.4, low=0.5, high=0.9, hue=0.15))
     floor = finish(rng, FLOOR_TEXTURES, plain=0.3, low=0.3, high=0.6, hue=0.08, tint=0.45)
     style = {
         "desk": _pick(rng, LAMINATES), "table": _pick(rng, LAMINATES),
@@ -377,11 +375,7 @@ def offices_scene(rng: np.random.Generator) -> Scene:
     for _ in range(int(rng.integers(0, 4))):            # plants standing free
         centre = rng.uniform(bounds[0], bounds[1])
         room.place(potted_plant(rng, (float(centre[0]), float(centre[1]))))
-    for side in range(4):
-        if side not in window_sides:
-            wall = walls[side]
-            room.landmarks += decor(rng, wall, 1.0, wall.thickness / 2,
-                                     wall.length - wall.thickness / 2, int(rng.integers(1, 4)))
+    room.landmarks += wall_decor(rng, walls, skip=window_sides)
     return Scene(name="offices", bounds=bounds, walls=tuple(walls),
                  landmarks=tuple(room.landmarks), floor_color=floor["color"],
                  floor_texture=floor["texture"], meshes=room.parts(), sky_color=horizon,

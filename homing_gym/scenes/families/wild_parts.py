@@ -14,7 +14,7 @@ import numpy as np
 import trimesh
 
 from homing_gym.scenes.mesh_part import MeshPart
-from homing_gym.scenes.random_nature import GAP, GROUND_RADIUS, _unit_ball
+from homing_gym.scenes.random_nature import GAP, _disc, _unit_ball
 
 RGB = np.ndarray
 Mesh = tuple[np.ndarray, np.ndarray]
@@ -107,31 +107,12 @@ def open_part(triangles: np.ndarray, colors: np.ndarray, name: str) -> MeshPart:
                     np.clip(colors, 0, 1), collision=False, name=name, solid_faces=())
 
 
-@lru_cache(maxsize=1)
-def _disc() -> Mesh:
-    """Vertices and faces of a flat disc of :data:`GROUND_RADIUS`: 14 rings growing
-    outwards from 0.5 m, 36 sectors (made once)."""
-    radii = np.concatenate([[0.0], np.geomspace(0.5, GROUND_RADIUS, 14)])
-    sectors = 36
-    a = np.linspace(0, 2 * math.pi, sectors, endpoint=False)
-    ring = np.stack([np.cos(a), np.sin(a), np.zeros(sectors)], axis=1)
-    vertices = np.concatenate([[[0.0, 0.0, 0.0]]] + [r * ring for r in radii[1:]])
-    faces = [[0, 1 + k, 1 + (k + 1) % sectors] for k in range(sectors)]
-    for i in range(len(radii) - 2):
-        inner, outer = 1 + i * sectors, 1 + (i + 1) * sectors
-        for k in range(sectors):
-            k1 = (k + 1) % sectors
-            faces += [[inner + k, outer + k, outer + k1], [inner + k, outer + k1, inner + k1]]
-    vertices, faces = np.array(vertices), np.array(faces)
-    vertices.flags.writeable = faces.flags.writeable = False
-    return vertices, faces
-
-
 def ground(rng: np.random.Generator, dark: RGB, light: RGB) -> MeshPart:
-    """The ground out to :data:`GROUND_RADIUS` metres, non-colliding, each face a blend of
-    ``dark`` and ``light``: patches 1.5-5 m across (a few random waves over the floor)
-    speckled face by face (leaf litter, gravel). Plain colours, not a texture: a textured
-    ground halves the ray caster's speed."""
+    """The ground out to :data:`~homing_gym.scenes.random_nature.GROUND_RADIUS` metres
+    (random_nature's disc), non-colliding, each face a blend of ``dark`` and ``light``:
+    patches 1.5-5 m across (a few random waves over the floor) speckled face by face (leaf
+    litter, gravel). Plain colours, not a texture: a textured ground halves the ray
+    caster's speed."""
     vertices, faces = _disc()
     centres = vertices[faces].mean(axis=1)[:, :2]
     waves = rng.normal(size=(4, 2))

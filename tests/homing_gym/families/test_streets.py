@@ -1,32 +1,17 @@
-"""The streets family: worlds reproducible from the seed and distinct across seeds, a
-street or a plaza lined by building blocks with windowed facades and a skyline beyond,
-little sky between 10 and 25 degrees up, furniture the robot bumps into and flat marks it
-drives over, LocalHoming episodes in every world."""
+"""The streets family: a street or a plaza lined by building blocks with windowed facades
+and a skyline beyond, little sky between 10 and 25 degrees up, furniture the robot bumps
+into and flat marks it drives over."""
 
 import math
-from dataclasses import replace
 
 import numpy as np
 
 from homing_gym.paths import regions
-from homing_gym.scenes import SceneFactory
 from homing_gym.scenes.base import clearances
-from homing_gym.scenes.families.streets import REACH, streets_scene
-from homing_gym.scenes.mesh_part import MeshPart
-from homing_gym.scenes.random_nature import random_nature_scene
+from homing_gym.scenes.families.streets import REACH
 
-FORWARD = np.array([1.0, 0.0], np.float32)
+FAMILY = "streets"
 PASSABLE = {"ground", "road", "marks", "crowns", "water"}
-
-
-def _world(seed):
-    return streets_scene(np.random.default_rng(seed))
-
-
-def _signature(scene) -> tuple:
-    meshes = tuple((p.name, p.vertices.round(9).tobytes(), p.face_colors.round(9).tobytes(),
-                    None if p.texture is None else p.texture.tobytes()) for p in scene.meshes)
-    return scene.bounds, scene.sky_color, scene.appearance, meshes
 
 
 def _buildings(scene) -> np.ndarray:
@@ -56,15 +41,8 @@ def _lined(blocks: np.ndarray, scene) -> list[float]:
     return shares
 
 
-def _part(scene, name):
-    return next(p for p in scene.meshes if p.name == name)
-
-
-def test_worlds_are_reproducible_and_distinct():
-    assert _signature(_world(7)) == _signature(_world(7))
-    worlds = [_world(seed) for seed in range(8)]
-    assert len({_signature(w) for w in worlds}) == 8
-    assert len({w.bounds for w in worlds}) == 8
+def test_worlds_are_streets_and_plazas_of_fenced_floor_cheap_to_cast(world):
+    worlds = [world(seed) for seed in range(8)]
     assert {w.metadata["layout"] for w in worlds} == {"street", "plaza"}
     for w in worlds:
         assert w.name == "streets" and w.fence and not w.ground_plane and not w.walls
@@ -74,16 +52,14 @@ def test_worlds_are_reproducible_and_distinct():
         assert sum(len(p.faces) for p in w.meshes) < 4000          # cheap to cast
 
 
-def test_the_generator_declares_the_solids_trimesh_would_find():
-    for part in _world(2).meshes:
-        if part.solid_faces:
-            found = MeshPart(part.vertices, part.faces, part.face_colors, name=part.name).solids
-            assert sorted(map(tuple, part.solids)) == sorted(map(tuple, found)), part.name
+def test_the_generator_declares_the_solids_trimesh_would_find(world,
+                                                              assert_solids_as_trimesh_finds):
+    assert_solids_as_trimesh_finds(p for p in world(2).meshes if p.solid_faces)
 
 
-def test_blocks_line_the_floor_with_windowed_facades_and_a_skyline_beyond():
+def test_blocks_line_the_floor_with_windowed_facades_and_a_skyline_beyond(world):
     for seed in range(10):
-        scene = _world(seed)
+        scene = world(seed)
         blocks = _buildings(scene)
         (xmin, ymin), (xmax, ymax) = scene.bounds
         shares = _lined(blocks, scene)
@@ -108,55 +84,26 @@ def test_blocks_line_the_floor_with_windowed_facades_and_a_skyline_beyond():
         assert regions(scene, 0.22, 0.05).max() == 1             # one floor, no pockets
 
 
-def test_little_sky_shows_between_the_blocks(make_env):
+def test_little_sky_shows_between_the_blocks(world, sky_seen):
     """With a magenta sky, little of it shows 10-25 degrees above the horizon, where
     random_nature shows mostly sky."""
-    def sky_share(scene, seed):
-        plain = replace(scene, appearance=replace(scene.appearance, sky_zenith=None))
-        env = make_env(scene=plain, start_distance=(0.3, 2.0), camera_height=0.2,
-                       sky_color=(1.0, 0.0, 1.0), panorama_shape=(48, 256))
-        pano = env.reset(seed=seed)[0]["panorama"].astype(int)
-        sky = (pano[..., 0] > 200) & (pano[..., 1] < 40) & (pano[..., 2] > 200)
-        return sky[4:16].mean()                # 1.25 degrees a row: 25 to 10 degrees up
-    assert max(sky_share(_world(seed), seed) for seed in range(3)) < 0.3
-    assert sky_share(random_nature_scene(np.random.default_rng(0)), 0) > 0.5
+    assert max(sky_seen(world(seed), seed)[4:16].mean() for seed in range(3)) < 0.3
+    assert sky_seen(world(0, "random_nature"), 0)[4:16].mean() > 0.5
 
 
-def test_local_homing_episodes_are_drawn_in_every_world(make_env):
-    env = make_env(scene=SceneFactory(build=streets_scene, randomised=True),
-                   start_distance=(0.3, 2.0))
-    for seed in range(5):
-        _, info = env.reset(seed=seed)
-        assert 0.3 <= math.dist(info["home_pose"][:2], info["start_pose"][:2]) <= 2.0
-        assert env.unwrapped.scene.name == "streets"
-
-
-def test_only_furniture_and_buildings_block_the_robot():
-    scene = _world(0)
-    (xmin, ymin), (xmax, ymax) = scene.bounds
-    gx, gy = np.meshgrid(np.linspace(xmin, xmax, 50), np.linspace(ymin, ymax, 80))
-    grid = np.stack([gx.ravel(), gy.ravel()], 1)
+def test_only_furniture_and_buildings_block_the_robot(world, floor_grid, without):
+    scene = world(0)
+    grid = floor_grid(scene, shape=(50, 80))
     free = clearances(scene, grid)
-    passable = replace(scene, meshes=tuple(p for p in scene.meshes if p.name not in PASSABLE))
-    assert np.array_equal(free, clearances(passable, grid))
-    bare = replace(scene, meshes=tuple(p for p in scene.meshes if p.name != "furniture"))
-    opened = clearances(bare, grid)
+    assert np.array_equal(free, clearances(without(scene, *PASSABLE), grid))
+    opened = clearances(without(scene, "furniture"), grid)
     assert np.all(opened >= free) and np.any(opened > free + 0.3)
 
 
-def _drive(env, start, steps):
-    env.reset(seed=0, options={"start": start})
-    collided = False
-    for _ in range(steps):
-        _, _, _, _, info = env.step(FORWARD)
-        collided |= info["collision"]
-    return collided, info["pose"]
-
-
-def test_robot_bumps_into_furniture_and_drives_over_road_marks(make_env):
-    scene = _world(0)
-    env = make_env(scene=scene, start_distance=(0.3, 2.0), max_episode_steps=-1)
-    furniture = _part(scene, "furniture")
+def test_robot_bumps_into_furniture_and_drives_over_road_marks(world, part, drive,
+                                                               line_through):
+    scene = world(0)
+    furniture = part(scene, "furniture")
     bumped = 0
     for faces in furniture.solids[:12]:
         corners = furniture.vertices[np.unique(furniture.faces[faces])]
@@ -169,22 +116,14 @@ def test_robot_bumps_into_furniture_and_drives_over_road_marks(make_env):
             start = centre - (reach + 0.5) * heading
             line = start + np.linspace(0, 0.25, 6)[:, None] * heading
             if clearances(scene, line).min() > 0.22:
-                collided, pose = _drive(env, (*start, a), 40)
+                collided, pose = drive(scene, (*start, a), 40)
                 assert collided and np.abs(pose[:2] - centre).max() > 0.1
                 bumped += 1
                 break
         if bumped == 2:
             break
     assert bumped == 2
-    marks = _part(scene, "marks").triangles
-    for corner in marks[::5, 0, :2]:              # a clear 1.2 m line across a mark
-        a = math.atan2(-corner[1], -corner[0]) + 0.3
-        heading = np.array([math.cos(a), math.sin(a)])
-        start = corner - 0.6 * heading
-        line = start + np.linspace(0, 1.4, 29)[:, None] * heading
-        if clearances(scene, line).min() > 0.3:
-            break
-    else:
-        raise AssertionError("no clear line across a mark")
-    collided, pose = _drive(env, (*start, a), 35)
-    assert not collided and math.dist(pose[:2], start) > 0.9
+    marks = part(scene, "marks").triangles        # a clear 1.4 m line across a mark
+    start = line_through(scene, marks[::5, 0, :2], length=1.4, turn=0.3, what="a mark")
+    collided, pose = drive(scene, start, 35)
+    assert not collided and math.dist(pose[:2], start[:2]) > 0.9
