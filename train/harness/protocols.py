@@ -244,6 +244,8 @@ COMMON_SEED = 20_000_000
 #: ``unseen-families``' seeds: the test families are held out whole, so any seed would
 #: do; these are clear of every other protocol's.
 FAMILIES_SEED = 30_000_000
+#: ``validation-families``' seeds.
+VALIDATION_SEED = 40_000_000
 #: Every classical method that runs LocalHoming from pixels alone, and the policies.
 FAMILY_METHODS = ("oracle", "random", "snapshot", "warping", "min-warping", "distance", "alv",
                   "did", POLICIES)
@@ -258,11 +260,11 @@ def _held_out(episodes: int, seed: int) -> list[Task]:
     return [(UNSEEN_SEED + seed + i, None, None) for i in range(episodes)]
 
 
-def _family_seeds(k: int, episodes: int, seed: int) -> list[Task]:
-    """Seeds from :data:`FAMILIES_SEED` on for the ``k``-th test family, a million apart
-    from the next family's (the same seed draws the same sky, light and camera height in
-    every family: each family gets its own)."""
-    first = FAMILIES_SEED + 1_000_000 * k + seed
+def _family_seeds(k: int, episodes: int, seed: int, first_seed: int = 0) -> list[Task]:
+    """Seeds from ``first_seed`` (default :data:`FAMILIES_SEED`) on for a protocol's
+    ``k``-th family, a million apart from the next family's (the same seed draws the same
+    sky, light and camera height in every family: each family gets its own)."""
+    first = (first_seed or FAMILIES_SEED) + 1_000_000 * k + seed
     return [(first + i, None, None) for i in range(episodes)]
 
 
@@ -403,6 +405,15 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
                       partial(_family_seeds, k), V2_SIMULATION)
               for k, name in enumerate(families_in("test"))),
         FAMILY_METHODS, episodes=100),
+    Protocol(
+        "validation-families", 1, "the validation families (:data:`~homing_gym.scenes."
+        f"families.FAMILIES`, role 'validation'): {', '.join(families_in('validation'))}, "
+        "for choosing recipes and checkpoints (never the test families); otherwise as "
+        f"unseen-families, seeds from {VALIDATION_SEED}",
+        tuple(Setting(name, LOCAL, {"scene": name, "start_distance": [0.3, 2.0]},
+                      partial(_family_seeds, k, first_seed=VALIDATION_SEED), V2_SIMULATION)
+              for k, name in enumerate(families_in("validation"))),
+        FAMILY_METHODS, episodes=50),
 )}
 
 

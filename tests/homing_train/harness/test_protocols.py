@@ -94,9 +94,9 @@ def test_a_policy_keeps_its_own_renderer_and_physics():
 
 def test_protocols_pin_their_renderer_and_physics():
     """The protocols of homing-gym 0.1 (version 1) were measured with TinyRenderer and
-    1/240 s, their later versions and the protocols made since (unseen-families) ray cast
+    1/240 s, their later versions and the protocols made since (the families' protocols) ray cast
     at 1/120 s; both are explicit, so a change of the env defaults changes no cell."""
-    since_0_2 = {"unseen-families"}
+    since_0_2 = {"unseen-families", "validation-families"}
     for p in PROTOCOLS.values():
         for setting in p.settings:
             kwargs = setting.kwargs()
