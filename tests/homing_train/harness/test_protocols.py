@@ -413,3 +413,16 @@ def test_a_method_that_knows_ground_truth_is_named_so_in_its_row():
     assert rows == {"oracle (privileged: true poses and the world's map)", "warping",
                     "multires (privileged: the taught maps' 3-D feature points and target "
                     "poses, from the scene (map_points, map_pose))"}
+
+
+def test_the_families_protocols_hold_out_the_test_families_with_their_own_seeds():
+    """unseen-families measures exactly the test families, validation-families exactly
+    the validation ones; no seed is shared between two families or the two protocols."""
+    from homing_gym.scenes.families import families_in
+    test, validation = protocol("unseen-families"), protocol("validation-families")
+    assert [s.env_kwargs["scene"] for s in test.settings] == list(families_in("test"))
+    assert [s.env_kwargs["scene"] for s in validation.settings] == list(families_in("validation"))
+    seeds = [seed for p in (test, validation) for s in p.settings
+             for seed, _, _ in s.episode_tasks(p.episodes, p.seed)]
+    assert len(seeds) == len(set(seeds)) == 3 * 100 + 2 * 50
+    assert all(s.env_kwargs["start_distance"] == [0.3, 2.0] for s in test.settings)
