@@ -124,14 +124,14 @@ def landmark_ring(panorama: np.ndarray, config: RedSegmentation = RedSegmentatio
 
 
 def ring_arcs(ring: np.ndarray, config: RedSegmentation = RedSegmentation()) -> list[Arc]:
-    """Arcs of a 1-D ring, seam-aware, sorted by bearing counter-clockwise from -π."""
+    """Arcs of a 1-D ring, seam-aware, sorted by bearing counter-clockwise from -π; none
+    when no sample or every sample is landmark (red all round, e.g. a world of red brick:
+    no landmark can be told from another, so none has a bearing)."""
     ring = np.asarray(ring, dtype=np.float64)
     W = ring.size
     on = ring > config.edge_threshold
-    if not on.any():
+    if not on.any() or on.all():
         return []
-    if on.all():
-        raise ValueError("the whole ring is landmark: no arcs can be separated")
     start = int(np.argmin(on))  # an off column: runs cannot wrap past it
     order = (start + np.arange(W)) % W
     arcs = []

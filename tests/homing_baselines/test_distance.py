@@ -280,3 +280,17 @@ def test_run_episodes_takes_a_home_pose_per_task():
     assert recs[2].home_pose != pytest.approx(list(home), abs=1e-4)
     with pytest.raises(ValueError):
         run_episodes(policy_spec("oracle"), "homing_gym/LocalHoming-v0", {}, [(1, None, None, 0)])
+
+
+def test_a_ring_red_all_round_has_no_landmarks_and_the_controller_acts():
+    """A world red all round (red brick streets) separates no landmark: no arcs, and the
+    controller still answers (it crashed the unseen-families suite before)."""
+    from homing_baselines.landmarks_red import detect_landmarks, ring_arcs
+    assert ring_arcs(np.ones(360)) == [] and ring_arcs(np.zeros(360)) == []
+    red = np.zeros((48, 256, 3), np.uint8)
+    red[..., 0] = 200
+    assert detect_landmarks(red) == []
+    controller = DistanceController()
+    controller.reset()
+    for _ in range(3):       # no landmark: no estimate; it moves on or stops, no error
+        controller.decide({"panorama": red, "goal": red, "odometry": np.zeros(3, np.float32)})
