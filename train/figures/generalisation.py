@@ -122,6 +122,36 @@ def by_distance_figure(results: dict[str, list[SceneResult]], path: Path,
     plt.close(fig)
 
 
+def per_scene_figure(results: dict[str, list[SceneResult]], path: Path) -> None:
+    """Grouped bars: success % per scene, one bar per method, Wilson 95 % intervals."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    labels = [_scene(r.label) for r in next(iter(results.values()))]
+    counts = sorted({len(r.episodes) for rows in results.values() for r in rows})
+    width = 0.8 / len(results)
+    fig, ax = plt.subplots(figsize=(max(7.0, 1.9 * len(labels)), 3.8), dpi=150)
+    for k, (method, rows) in enumerate(results.items()):
+        x = np.arange(len(rows)) + (k - (len(results) - 1) / 2) * width
+        rate = np.array([r.successes / len(r.episodes) for r in rows])
+        ci = np.array([wilson_interval(r.successes, len(r.episodes)) for r in rows])
+        ax.bar(x, 100 * rate, width, color=method_color(method), label=method)
+        ax.errorbar(x, 100 * rate, yerr=100 * np.abs(ci.T - rate), fmt="none",
+                    ecolor="0.25", elinewidth=0.8, capsize=1.5)
+    ax.set_xticks(np.arange(len(labels)), labels)
+    ax.set_ylabel("success % (stopped within radius)")
+    ax.set_ylim(0, 100)
+    ax.set_title(f"{'/'.join(map(str, counts))} episodes per bar, Wilson 95 % intervals",
+                 fontsize=8)
+    ax.legend(fontsize=7, ncol=(len(results) + 1) // 2, loc="upper center",
+              bbox_to_anchor=(0.5, -0.1), frameon=False)
+    ax.spines[["top", "right"]].set_visible(False)
+    fig.tight_layout()
+    save_figure(fig, path, bbox_inches="tight")
+    plt.close(fig)
+
+
 def _scene(label: str) -> str:
     """A setting's label without the protocol's note (``hallway (held out)`` ->
     ``hallway``)."""

@@ -63,3 +63,12 @@ def test_failures_figure_has_a_row_per_method_that_failed(tmp_path):
 def test_an_empty_folder_is_refused(tmp_path):
     with pytest.raises(ValueError, match="cell.json"):
         load_results(tmp_path)
+
+
+def test_the_command_writes_the_table_and_three_figures(tmp_path):
+    from homing_train.figures.generalisation import main
+    _write_cell(tmp_path / "cells", "warping", {"arena": [True, False]})
+    assert main(["--cells", str(tmp_path / "cells"), "--out", str(tmp_path / "out")]) == 0
+    written = sorted(p.name for p in (tmp_path / "out").iterdir())
+    assert written == ["by_distance.png", "failures.png", "per_scene.md", "per_scene.png"]
+    assert imageio.imread(tmp_path / "out" / "by_distance.png").ndim == 3
