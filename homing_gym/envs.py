@@ -186,7 +186,8 @@ class RouteFollowingEnv(HomingEnv):
     corridor. The robot starts ``spacing`` (1 ft) before the first target and must home to each target
     in turn; the goal observation is the snapshot of the current target and switches to
     the next one when a target is reached. ``route`` gives any other route, curved or
-    not, in any scene: the robot's start point followed by the targets.
+    not, in any scene: the robot's start point followed by the targets; ``route="random"``
+    draws a new curved route in each episode's world.
 
     ## Action space
 
@@ -255,8 +256,12 @@ class RouteFollowingEnv(HomingEnv):
     the direction of travel from the previous point; consecutive points at least 0.05 m
     apart, every point inside the scene with room for the robot's body, 0.16 m of
     clearance, and joined to the next by a path for it; it replaces the straight route,
-    so ``n_targets`` and ``spacing`` must then keep their defaults. A bad ``route`` raises
-    ``ValueError``.
+    so ``n_targets`` and ``spacing`` must then keep their defaults. ``route="random"``:
+    each episode draws its own route from the seed, ``n_targets`` legs of ``spacing``
+    metres, the first in any direction, each turning by up to 30 degrees from the last,
+    every point and leg 0.18 m clear of walls and objects, in any scene (built-in,
+    procedural, a mesh); a scene that cannot hold one raises ``ValueError`` at reset. A
+    bad ``route`` raises ``ValueError``.
 
     ## Version history
 
@@ -266,9 +271,10 @@ class RouteFollowingEnv(HomingEnv):
     ARGUMENTS: dict[str, Row] = {
         "scene": (SCENE[0] + " with `metadata['route_origin']`, or any with `route`", "",
                   SCENE[2]),
-        "n_targets": ("integer in [1, 9,999]", "", "targets of the straight route"),
-        "spacing": ("[0.05, 100]", "metres", "distance between the straight route's targets"),
-        "route": ("`None`, points or a file (see above)", "metres, radians",
+        "n_targets": ("integer in [1, 9,999]", "", "targets of the straight or random route"),
+        "spacing": ("[0.05, 100]", "metres",
+                    "distance between the straight or random route's targets"),
+        "route": ("`None`, points, a file or `\"random\"` (see above)", "metres, radians",
                   "any other route: the start, then the targets"),
         "route_view_spacing": ("[0.01, 2], at most the route's length", "metres",
                                "largest distance between the teaching views "

@@ -15,7 +15,7 @@ from typing import ClassVar
 import numpy as np
 
 from homing_gym.observations import ObservationKey
-from homing_gym.paths import BODY_RADIUS, RESOLUTION, occupancy
+from homing_gym.paths import BODY_RADIUS, RESOLUTION, occupancy, segment_free
 from homing_gym.scenes.base import MAX_SIDE, Scene, clearance
 from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.episode import Episode
@@ -137,3 +137,38 @@ def sample_free_pose(scene: Scene, rng: np.random.Generator, margin: float,
     raise ValueError(f"scene {scene.name!r} has no floor point with {margin} m of clearance "
                      f"(none found among {len(cells)} free grid cells of "
                      f"{RESOLUTION} m)")
+
+
+def random_route(scene: Scene, start, rng: np.random.Generator, length: float,
+                 margin: float, legs: tuple[float, float] = (0.8, 2.0),
+                 max_turn: float = 2 * math.pi / 3, max_restarts: int = 200) -> np.ndarray:
+    """A collision-free polyline ``(K, 2)`` (m) from ``start`` of total length ``length``:
+    legs of uniform length in ``legs`` (the last one cut to fit), each turning by up to
+    ``max_turn`` radians either way from the last (any direction for the first), every
+    point ``margin`` m clear of walls and objects (checked every 5 cm), so that the route's
+    end is joined to its start by a path for a disc of radius ``margin``. A leg with no
+    clear direction in 30 draws restarts the route; ``ValueError`` naming the scene, the
+    length and the margin after ``max_restarts`` routes."""
+    for _ in range(max_restarts):
+        points = [np.asarray(start[:2], dtype=np.float64)]
+        heading = float(rng.uniform(-math.pi, math.pi))
+        total = 0.0
+        while total < length - 1e-9:
+            leg = min(float(rng.uniform(*legs)), length - total)
+            for _ in range(30):
+                turn = rng.uniform(-math.pi, math.pi) if len(points) == 1 \
+                    else rng.uniform(-max_turn, max_turn)
+                h = heading + float(turn)
+                end = points[-1] + leg * np.array([math.cos(h), math.sin(h)])
+                if segment_free(scene, points[-1], end, margin, step=0.05):
+                    points.append(end)
+                    heading, total = h, total + leg
+                    break
+            else:
+                break
+        if total >= length - 1e-9:
+            return np.array(points)
+    raise ValueError(f"scene {scene.name!r} of size {scene.size} m cannot hold a route of "
+                     f"{length} m (legs of {legs[0]}-{legs[1]} m turning by up to "
+                     f"{math.degrees(max_turn):.0f} deg) with {margin} m of clearance; use a "
+                     f"larger or more open scene or a shorter route")

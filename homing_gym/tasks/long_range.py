@@ -19,11 +19,10 @@ from gymnasium import spaces
 
 from homing_gym.geometry import bearing_to
 from homing_gym.observations import ObservationKey, constant_key
-from homing_gym.paths import segment_free
 from homing_gym.sim.robot import RobotConfig
 from homing_gym.scenes.base import Scene
 from homing_gym.tasks.context import TaskContext
-from homing_gym.tasks.base import Episode, sample_free_pose
+from homing_gym.tasks.base import Episode, random_route, sample_free_pose
 from homing_gym.tasks.goal_reaching import GoalReachingTask, RewardConfig
 from homing_gym.validation import is_real, require_positive
 
@@ -33,38 +32,6 @@ OUTBOUND, HOMING = 0, 1
 WAYPOINT_RADIUS = 0.05
 #: Heading error (rad) above which the outbound driver turns on the spot.
 TURN_FIRST = 0.2
-
-
-def plan_route(scene: Scene, start, rng: np.random.Generator, length: float,
-               margin: float, legs: tuple[float, float] = (0.8, 2.0),
-               max_restarts: int = 200) -> np.ndarray:
-    """A collision-free polyline ``(K, 2)`` (m) from ``start`` of total length ``length``:
-    legs of uniform length in ``legs``, each turning by up to 120 degrees from the last
-    (any direction for the first), every point ``margin`` m clear of walls and objects
-    (checked every 5 cm), so that the route's end is joined to its start by a path for a
-    disc of radius ``margin``. ``ValueError`` if the scene cannot hold such a route."""
-    for _ in range(max_restarts):
-        points = [np.asarray(start[:2], dtype=np.float64)]
-        heading = float(rng.uniform(-math.pi, math.pi))
-        total = 0.0
-        while total < length - 1e-9:
-            leg = min(float(rng.uniform(*legs)), length - total)
-            for _ in range(30):
-                turn = rng.uniform(-math.pi, math.pi) if len(points) == 1 \
-                    else rng.uniform(-2 * math.pi / 3, 2 * math.pi / 3)
-                h = heading + float(turn)
-                end = points[-1] + leg * np.array([math.cos(h), math.sin(h)])
-                if segment_free(scene, points[-1], end, margin, step=0.05):
-                    points.append(end)
-                    heading, total = h, total + leg
-                    break
-            else:
-                break
-        if total >= length - 1e-9:
-            return np.array(points)
-    raise ValueError(f"scene {scene.name!r} of size {scene.size} m cannot hold a route of "
-                     f"{length} m with {margin} m of clearance; use a larger scene or a "
-                     f"shorter route_length")
 
 
 class LongRangeHomingTask(GoalReachingTask):
@@ -120,7 +87,7 @@ class LongRangeHomingTask(GoalReachingTask):
 
     def on_reset(self, ctx: TaskContext) -> None:
         super().on_reset(ctx)
-        self.route = plan_route(ctx.scene(), ctx.episode().start, ctx.rng(),
+        self.route = random_route(ctx.scene(), ctx.episode().start, ctx.rng(),
                                 self.route_length, self.clearance_margin)
         self.phase, self.waypoint, self.outbound_steps = OUTBOUND, 1, 0
 

@@ -6,9 +6,14 @@ Teaching views (opt-in, observation key ``route_views``): the panoramas the robo
 while it was led along the route, for methods that learn a route from the views along it
 (familiarity-based route following, Baddeley et al. 2012). They are taken at
 :func:`route_view_poses`, each facing the direction of travel there, under snapshot-time
-lighting (as the targets' snapshots), once per episode at reset (once per world: a world
-that does not change keeps its views), and reach the agent through the observation, never
-through ``info``.
+lighting (as the targets' snapshots), at reset whenever the route or the world is new (a
+fixed route in a world that does not change keeps its views), and reach the agent through
+the observation, never through ``info``.
+
+Random routes (``route="random"``): each episode draws its own curved route of
+``n_targets`` legs of ``spacing`` metres, turning by up to :data:`RANDOM_ROUTE_TURN` per
+leg, through the free floor of the episode's world (:func:`~homing_gym.tasks.base.
+random_route`): routes through any world, built-in, procedural or a user's mesh.
 """
 
 from __future__ import annotations
@@ -29,7 +34,7 @@ from homing_gym.paths import BODY_RADIUS, joined_in_order
 from homing_gym.scenes.base import MAX_SIDE, Scene, clearances
 from homing_gym.tasks.context import TaskContext
 from homing_gym.tasks.base import (Episode, check_start_jitter, check_start_off_goal,
-                                   checked_start_jitter)
+                                   checked_start_jitter, random_route, sample_free_pose)
 from homing_gym.tasks.goal_reaching import GoalReachingTask, RewardConfig
 from homing_gym.tasks.route_file import MAX_ROUTE_POINTS, load_route
 from homing_gym.validation import require_number
@@ -44,6 +49,12 @@ ROUTE_VIEW_SPACING, MIN_ROUTE_VIEW_SPACING, MAX_ROUTE_VIEW_SPACING = 0.1, 0.01, 
 MAX_ROUTE_VIEWS = 512
 #: The observation key of the teaching views.
 ROUTE_VIEWS_KEY = "route_views"
+#: ``route`` asking for a random route per episode (a route file of that name: "./random").
+RANDOM_ROUTE = "random"
+#: Largest turn (radians) between consecutive legs of a random route: 30 degrees per leg
+#: bends a route of 17 one-foot legs by about 70 degrees on average (Baddeley et al.'s
+#: routes meander without looping back); any direction for the first leg.
+RANDOM_ROUTE_TURN = math.radians(30)
 
 
 def _is_sequence(value) -> bool:
@@ -131,7 +142,9 @@ class RouteFollowingTask(GoalReachingTask):
     the robot starting ``spacing`` metres before the first target. With ``route`` (points
     (x, y) or (x, y, yaw), see :func:`route_poses`) the robot starts at its first point and
     the other points are the targets, in order; ``n_targets`` and ``spacing`` must then
-    keep their defaults. The start is perturbed by up to ``start_jitter = (metres,
+    keep their defaults. With ``route="random"`` each episode draws a curved route of
+    ``n_targets`` legs of ``spacing`` metres (see the module doc), every point and leg
+    ``clearance_margin`` metres clear, its start clear of the jitter too. The start is perturbed by up to ``start_jitter = (metres,
     radians)`` (uniform in x, y and yaw). Every point of the straight route needs
     ``clearance_margin`` metres of clearance, every point of a given route room for the
     robot's body; each point must be joined to the next by a path for a disc of that
@@ -149,7 +162,8 @@ class RouteFollowingTask(GoalReachingTask):
                  reward: RewardConfig = RewardConfig(), clearance_margin: float = 0.18,
                  route: Sequence[Sequence[float]] | str | os.PathLike | None = None,
                  route_view_spacing: float = ROUTE_VIEW_SPACING):
-        route = load_route(route)                       # a path: the points of its file
+        self.random_route = isinstance(route, str) and route == RANDOM_ROUTE
+        route = None if self.random_route else load_route(route)   # a path: its points
         require_number("n_targets", n_targets, 1, MAX_ROUTE_POINTS - 1, "(a route holds at "
                        f"most {MAX_ROUTE_POINTS} points with its start)", integer=True)
         require_number("spacing", spacing, MIN_ROUTE_STEP, MAX_SIDE, "metres (the least "
@@ -169,10 +183,14 @@ class RouteFollowingTask(GoalReachingTask):
         self.clearance_margin = clearance_margin
         self.route_view_spacing = float(route_view_spacing)
         self._views: np.ndarray | None = None
-        self._views_scene: Scene | None = None
+        self._views_of: tuple | None = None           # (scene, route) the views show
+        self._drawn: np.ndarray | None = None         # this episode's random route
 
     def _route(self, scene: Scene) -> np.ndarray:
-        """The start point, then the targets: poses ``(n_targets + 1, 3)``."""
+        """The start point, then the targets: poses ``(n_targets + 1, 3)`` (a random
+        route: this episode's)."""
+        if self.random_route:
+            return self._drawn.copy()
         if self.route is not None:
             return self.route.copy()
         x0, y0, yaw = scene.metadata["route_origin"]
@@ -190,6 +208,10 @@ class RouteFollowingTask(GoalReachingTask):
         """``ValueError`` unless every point of the route is clear (:attr:`path_radius`
         metres) and each is joined to the next by a path for a disc of that radius
         (:func:`homing_gym.paths.connected`), and every start of the jitter is clear."""
+        if self.random_route:
+            check_start_off_goal((0.0, 0.0), (self.spacing, 0.0), self.success_radius,
+                                 "a random route's start and its first target")
+            return
         if self.route is None and "route_origin" not in scene.metadata:
             raise ValueError(f"scene {scene.name!r} defines no route (metadata['route_origin']); "
                              f"use a scene with one, e.g. 'hallway', or give route=[...]")
@@ -252,7 +274,25 @@ class RouteFollowingTask(GoalReachingTask):
                              f"scene {scene.name!r}; the robot's body needs {BODY_RADIUS:.3f} "
                              f"m ({BODY_RADIUS - free[k]:.3f} m short)")
 
+    def _random_route(self, scene: Scene, rng: np.random.Generator) -> np.ndarray:
+        """A random route's poses (start point, then targets): the start drawn clear of
+        the jitter (:func:`sample_free_pose`), then :func:`random_route` at
+        ``clearance_margin``, redrawn while the grid the oracle plans on does not join
+        its points in order; ``ValueError`` naming the scene after 20 routes."""
+        margin, jitter = self.clearance_margin, self.start_jitter[0]
+        for _ in range(20):
+            start = sample_free_pose(scene, rng, margin + jitter * math.sqrt(2))
+            points = random_route(scene, start, rng, self.n_targets * self.spacing, margin,
+                                  legs=(self.spacing, self.spacing), max_turn=RANDOM_ROUTE_TURN)
+            if joined_in_order(scene, points, margin).all():
+                return route_poses(points)
+        raise ValueError(f"scene {scene.name!r}: no random route of {self.n_targets} legs of "
+                         f"{self.spacing} m whose points the oracle's grid joins at "
+                         f"{margin} m (tried 20); use fewer targets or a more open scene")
+
     def sample_episode(self, scene: Scene, rng: np.random.Generator) -> Episode:
+        if self.random_route:
+            self._drawn = self._random_route(scene, rng)
         before, *targets = self._route(scene)
         d, a = self.start_jitter
         start = before + np.array([rng.uniform(-d, d), rng.uniform(-d, d), rng.uniform(-a, a)])
@@ -266,15 +306,18 @@ class RouteFollowingTask(GoalReachingTask):
         route is too short for them or needs too many."""
         if self.route is not None:
             points = self.route
-        else:        # the straight route: n_targets spacings from the start point
+        else:        # straight or random: n_targets spacings from the start point
             points = np.array([[0.0, 0.0], [self.n_targets * self.spacing, 0.0]])
         return len(route_view_poses(points, self.route_view_spacing))
 
     def on_reset(self, ctx: TaskContext) -> None:
-        if ROUTE_VIEWS_KEY in ctx.obs_keys and ctx.scene() is not self._views_scene:
+        route = None if self._drawn is None else self._drawn.tobytes()
+        shown = self._views_of is not None and (self._views_of[0] is ctx.scene()
+                                                and self._views_of[1] == route)
+        if ROUTE_VIEWS_KEY in ctx.obs_keys and not shown:
             poses = route_view_poses(self._route(ctx.scene()), self.route_view_spacing)
             self._views = np.stack([ctx.snapshot(pose) for pose in poses])
-            self._views_scene = ctx.scene()
+            self._views_of = (ctx.scene(), route)
             ctx.place_robot(ctx.episode().start, self.fresh_contacts)
         super().on_reset(ctx)
 

@@ -80,14 +80,13 @@ def test_planned_routes_keep_their_margin_all_along_every_leg():
     # sampled every centimetre, not only where the planner looked (every 5 cm)
     from homing_gym.scenes import scene_factory
     from homing_gym.scenes.base import clearances
-    from homing_gym.tasks.base import sample_free_pose
-    from homing_gym.tasks.long_range import plan_route
+    from homing_gym.tasks.base import random_route, sample_free_pose
 
     scene = scene_factory("lab").build(np.random.default_rng(0))
     margin = 0.3
     for seed in range(30):
         rng = np.random.default_rng(seed)
-        route = plan_route(scene, sample_free_pose(scene, rng, margin), rng, 8.0, margin)
+        route = random_route(scene, sample_free_pose(scene, rng, margin), rng, 8.0, margin)
         assert sum(math.dist(a, b) for a, b in zip(route[:-1], route[1:])) == \
             pytest.approx(8.0)
         for a, b in zip(route[:-1], route[1:]):

@@ -138,3 +138,65 @@ def test_bad_routes_are_refused(kwargs, message):
 
     with pytest.raises(ValueError, match=message):
         gym.make(ROUTE, **kwargs)
+
+
+def _turns(goals: np.ndarray) -> np.ndarray:
+    legs = np.diff(goals[:, :2], axis=0)
+    heading = np.arctan2(legs[:, 1], legs[:, 0])
+    return np.abs((np.diff(heading) + math.pi) % (2 * math.pi) - math.pi)
+
+
+@pytest.mark.parametrize("scene", ["random_nature", "random_rooms", "lab"])
+def test_random_routes_are_clear_curved_and_drawn_from_the_seed(make_env, scene):
+    from homing_gym.paths import joined_in_order
+    from homing_gym.scenes.base import clearances
+    from homing_gym.tasks.route_following import RANDOM_ROUTE_TURN
+
+    env = make_env(ROUTE, scene=scene, route="random", n_targets=12, spacing=0.4,
+                   panorama_shape=(16, 64))
+    routes = []
+    for seed in (0, 1, 0):
+        _, info = env.reset(seed=seed)
+        task, world = env.unwrapped.task, env.unwrapped.scene
+        points = np.array([task._route(world)[0], *env.unwrapped.episode.goals])
+        assert len(points) == 13
+        assert np.allclose(np.hypot(*np.diff(points[:, :2], axis=0).T), 0.4)
+        assert _turns(points).max() <= RANDOM_ROUTE_TURN + 1e-9
+        assert clearances(world, points[:, :2]).min() >= task.clearance_margin - 1e-6
+        assert joined_in_order(world, points, task.clearance_margin).all()
+        assert math.dist(info["pose"][:2], points[0, :2]) <= 0.05 * math.sqrt(2) + 1e-3
+        routes.append(points)
+    assert np.array_equal(routes[0], routes[2]) and not np.allclose(routes[0], routes[1])
+
+
+def test_random_routes_teach_the_views_of_each_episodes_route(make_env):
+    # the last teaching view stands at the last target facing along the last leg: the
+    # last target's snapshot; a new episode's route brings new views
+    env = make_env(ROUTE, scene="random_nature", route="random", n_targets=5, spacing=0.3,
+                   route_view_spacing=0.3, panorama_shape=(16, 64), action_type="discrete",
+                   obs_keys=("panorama", "goal", "route_views"))
+    views = []
+    for seed in (2, 3):
+        obs, _ = env.reset(seed=seed)
+        assert obs["route_views"].shape == (6, 16, 64, 3)
+        for _ in range(4):                             # stop at once: the next target
+            obs, *_ = env.step(3)
+        assert np.array_equal(obs["route_views"][-1], obs["goal"])
+        views.append(obs["route_views"])
+    assert not np.array_equal(*views)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"scene": "arena", "n_targets": 40, "spacing": 2.0}, r"scene 'arena' .* cannot hold a "
+                                                          r"route of 80.0 m"),
+    ({"scene": "arena", "spacing": 0.08}, r"success_radius 0.1 m: a random route's start"),
+])
+def test_random_routes_that_cannot_be_drawn_are_refused(kwargs, message):
+    import gymnasium as gym
+
+    env = None
+    with pytest.raises(ValueError, match=message):
+        env = gym.make(ROUTE, route="random", **kwargs)
+        env.reset(seed=0)
+    if env is not None:
+        env.close()

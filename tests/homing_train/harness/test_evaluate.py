@@ -444,6 +444,17 @@ def test_route_shortest_path_visits_every_target(make_env, controller_for):
     assert record.spl > 0.85
 
 
+@pytest.mark.parametrize("scene", ["random_nature", "random_rooms"])
+def test_the_oracle_follows_random_routes_to_their_last_target(make_env, controller_for,
+                                                               scene):
+    env = make_env("homing_gym/RouteFollowing-v0", scene=scene, route="random", n_targets=8,
+                   panorama_shape=(16, 64))
+    record = run_episode(env, controller_for("oracle", env), seed=5)
+    assert record.success and record.collisions == 0
+    assert record.targets_finished == 8 and max(record.target_errors) < 0.1
+    assert record.spl > 0.85
+
+
 def test_compare_notes_say_which_rows_differ_in_renderer_and_settings():
     from homing_train.harness.compare import settings_notes
 
