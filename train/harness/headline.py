@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from typing import Mapping, Sequence
 
 import homing_baselines
-from homing_train.harness.matrix import Cell, cell_methods, shipped_for
+from homing_train.harness.matrix import Cell, cell_methods
 from homing_train.harness.policies import DEFAULT_POLICY, shipped_policies
 from homing_train.harness.protocols import PROTOCOLS, Protocol
 
@@ -64,7 +64,7 @@ def default_methods(protocols: Sequence[Protocol]) -> list[str]:
     names: list[str] = []
     for p in protocols:
         names += [m for m in cell_methods(p) if m in homing_baselines.available()]
-    if any(DEFAULT_POLICY in shipped_for({s.env_id for s in p.settings}) for p in protocols):
+    if any(DEFAULT_POLICY in cell_methods(p) for p in protocols):
         names.append(DEFAULT_POLICY)
     return list(dict.fromkeys(names))
 

@@ -48,8 +48,8 @@ import homing_baselines  # noqa: E402
 from homing_gym.cli import command_parser  # noqa: E402
 from homing_train.extras import missing_extra  # noqa: E402
 from homing_train.harness.evaluate import EpisodeRecord, evaluate, summarize  # noqa: E402
-from homing_train.harness.policies import (ShippedPolicy, recorded_settings,  # noqa: E402
-                                           shipped_policies)
+from homing_train.harness.policies import (DEFAULT_POLICY, ShippedPolicy,  # noqa: E402
+                                           recorded_settings, shipped_policies)
 from homing_train.harness.metrics import aggregate_success, wilson_interval  # noqa: E402
 from homing_train.harness.protocols import (POLICIES, PROTOCOLS, Protocol,  # noqa: E402
                                             episodes_key)
@@ -89,13 +89,19 @@ def shipped_for(env_ids: Sequence[str]) -> dict:
     return {name: p for name, p in shipped_policies().items() if p.env_id in env_ids}
 
 
+def protocol_policy_envs(protocol: Protocol) -> set[str]:
+    """The env ids whose shipped policies act in ``protocol``: its settings' and its
+    ``policy_envs``."""
+    return {s.env_id for s in protocol.settings} | set(protocol.policy_envs)
+
+
 def cell_methods(protocol: Protocol) -> list[str]:
     """The protocol's methods, ``policies`` replaced by the shipped policies trained on
     its envs."""
     names: list[str] = []
     for method in protocol.methods:
         if method == POLICIES:
-            names += sorted(shipped_for({s.env_id for s in protocol.settings}))
+            names += sorted(shipped_for(protocol_policy_envs(protocol)))
         else:
             names.append(method)
     return names
@@ -180,15 +186,16 @@ def setting_stem(label: str) -> str:
 def run_cell(protocol: Protocol, method: str, out: Path, episodes: int | None = None,
              workers: int = 1, progress: bool = True, resume: bool = False,
              backend: str = "local", address: str | None = None) -> Cell:
-    """Run ``method`` (a controller name, a shipped policy's, or the path of a PPO model
-    zip, evaluated with :func:`~homing_train.harness.policies.recorded_settings` as a
-    shipped one is) on every setting of ``protocol`` (``episodes`` per setting, default
+    """Run ``method`` (a controller name, a shipped policy's (``ppo``: the default one),
+    or the path of a PPO model zip, evaluated with
+    :func:`~homing_train.harness.policies.recorded_settings` as a shipped one is) on every setting of ``protocol`` (``episodes`` per setting, default
     the protocol's) into ``out`` (``backend``/``address``:
     :func:`homing_train.harness.evaluate.run_episodes`)."""
+    method = DEFAULT_POLICY if method == "ppo" else method
     n = protocol.episodes if episodes is None else episodes
     if n < 1:
         raise ValueError(f"episodes must be >= 1, got {n}")
-    shipped = shipped_for({s.env_id for s in protocol.settings})
+    shipped = shipped_for(protocol_policy_envs(protocol))
     if method.endswith(".zip") and os.path.isfile(method):
         recorded = recorded_settings(method)
         shipped[method] = ShippedPolicy(Path(method), recorded.env_kwargs, recorded.params,
@@ -340,9 +347,11 @@ README_END = "<!-- matrix end -->"
 
 
 def readme_block(cells: Sequence[Cell], source: str) -> str:
-    """The README's matrix: the success table of :func:`matrix_markdown` and where the
-    cells come from (``source``: the matrix.json) and how they were made."""
-    table = "\n\n".join(matrix_markdown(cells).split("\n\n")[:2])
+    """The README's matrix: the success table of :func:`matrix_markdown` with its notes
+    and where the cells come from (``source``: the matrix.json) and how they were made."""
+    blocks = matrix_markdown(cells).split("\n\n")
+    table = "\n\n".join(blocks[:next(i for i, b in enumerate(blocks)
+                                    if b.startswith("| protocol | method"))])
     episodes = sorted({c.summary["episodes"] for c in cells})
     return (f"{README_BEGIN}\n{table}\n\n*{len(cells)} cells, {episodes[0]}-{episodes[-1]} "
             f"episodes each, from [{source}]({source}); every cell's command, reached "
@@ -387,11 +396,17 @@ def matrix_markdown(cells: Sequence[Cell]) -> str:
                if redrawn else [""]),
              "| method | " + " | ".join(protocols) + " |",
              "|---|" + "---:|" * len(protocols)]
+    no_policy = {p: PROTOCOLS[p].no_policy for p in protocols
+                 if p in PROTOCOLS and PROTOCOLS[p].no_policy}
     for m in methods:
+        learned = m not in homing_baselines.available()
         row = [(_pct(by[(p, m)].summary, "success_rate", "success_ci") if (p, m) in by
-                else "") for p in protocols]
+                else "n/a" if learned and p in no_policy else "") for p in protocols]
         label = f"{m} (privileged: {privileged[m]})" if privileged[m] else m
         lines.append(f"| {label} | " + " | ".join(row) + " |")
+    if no_policy and any(m not in homing_baselines.available() for m in methods):
+        lines += ["", "n/a: no learned policy can act here. " + " ".join(
+            f"{p}: {why}." for p, why in no_policy.items())]
     lines += ["", "| protocol | method | episodes | success % [95% CI] | reached % [95% CI] "
               "| SPL | final distance (cm) | command |", "|---|---|---:|---:|---:|---:|---:|---|"]
     for c in cells:

@@ -179,6 +179,12 @@ class Protocol:
     privileged: str = ""               # anything beyond pixels the protocol gives
     place: str = ""                    # a place rule other than the radius (the task's)
     canonical_seed: int | None = None  # set by reseeded(): the protocol's own seed
+    #: Env ids whose shipped policies act here besides policies of the settings' own env
+    #: ids (a LocalHoming policy homes to a route's targets one by one).
+    policy_envs: tuple[str, ...] = ()
+    #: Why no shipped policy can act in this protocol ("" where one can); the matrix
+    #: says it in the policies' rows instead of leaving them blank.
+    no_policy: str = ""
 
     @property
     def canonical(self) -> bool:
@@ -234,6 +240,7 @@ FOOT = 0.3048
 #: Yu & Kim's nest: the arena's centre, among the four cylinders (§IV).
 NEST = (0.0, 0.0, 0.0)
 LOCAL = "homing_gym/LocalHoming-v0"
+ROUTE = "homing_gym/RouteFollowing-v0"
 HOMING_METHODS = ("oracle", "random", "snapshot", "warping", "distance", POLICIES)
 #: Held out from every shipped policy's training: seeds of the procedural worlds far from
 #: the training seeds, and scenes it never saw.
@@ -246,6 +253,11 @@ COMMON_SEED = 20_000_000
 FAMILIES_SEED = 30_000_000
 #: ``validation-families``' seeds.
 VALIDATION_SEED = 40_000_000
+#: ``routes``' seeds: clear of every training seed and of every other protocol's.
+ROUTES_SEED = 60_000_000
+#: Every method that follows a route from pixels alone, and the policies.
+ROUTE_METHODS = ("oracle", "random", "snapshot", "warping", "min-warping", "did",
+                 "perfect-memory", "infomax", POLICIES)
 #: Every classical method that runs LocalHoming from pixels alone, and the policies.
 FAMILY_METHODS = ("oracle", "random", "snapshot", "warping", "min-warping", "distance", "alv",
                   "did", POLICIES)
@@ -268,6 +280,13 @@ def _family_seeds(k: int, episodes: int, seed: int, first_seed: int = 0) -> list
     return [(first + i, None, None) for i in range(episodes)]
 
 
+def _route_seeds(k: int, episodes: int, seed: int) -> list[Task]:
+    """Seeds from :data:`ROUTES_SEED` on for ``routes``' ``k``-th setting, a million
+    apart from the next setting's."""
+    first = ROUTES_SEED + 1_000_000 * k + seed
+    return [(first + i, None, None) for i in range(episodes)]
+
+
 def _common(episodes: int, seed: int) -> list[Task]:
     """Seeds from :data:`COMMON_SEED` on: no training run starts in these worlds."""
     return [(COMMON_SEED + seed + i, None, None) for i in range(episodes)]
@@ -281,6 +300,8 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
                  {"scene": "hallway", "drive": "synchro", "panorama_shape": [60, 360],
                   "max_episode_steps": 200}, _hong_one_foot),),
         ("snapshot", "warping", "oracle", "random"), episodes=10,
+        no_policy="the synchro drive translates without turning, and every shipped "
+                  "policy acts by turning and stepping",
         claims=(Claim(
             "snapshot", "17 hallway images taken at targets about 1 ft apart; the robot, "
             "placed 1 ft from the first, homed to each in sequence and \"was able to traverse "
@@ -319,7 +340,7 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
         (Setting("lab, A-F", LOCAL, {"scene": "lab", "max_episode_steps": 800},
                  _bekris_goals),),
         ("bearing", "bearing-basic", "bearing-complementary", "warping", "oracle",
-         "random"), episodes=12, seed=11,
+         "random", POLICIES), episodes=12, seed=11,
         claims=(
             Claim("bearing", "the unified law, run 30 times to each of the 6 marked "
                   "positions (180 runs): accuracy \"in the order of a very few centimeters "
@@ -349,6 +370,8 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
         "briggs-corridors", 1, "Briggs et al.: LandmarkNavigation-v0 in the corridors",
         (Setting("corridors", "homing_gym/LandmarkNavigation-v0", {"scene": "corridors"}),),
         ("selfsimilar", "oracle", "random"), episodes=6,
+        no_policy="no shipped policy was trained on LandmarkNavigation-v0, whose goal is "
+                  "a landmark's panel image",
         place="stopped in front of the goal landmark (the task's rule: at most 1.2 m from "
               "the panel, within 30 deg of its normal, facing it)",
         claims=(Claim(
@@ -364,6 +387,8 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
         (Setting("house", "homing_gym/WorkLocations-v0",
                  {"scene": "house", "success_radius": 0.1}),),
         ("multires", "oracle", "random"), episodes=6,
+        no_policy="no shipped policy was trained on WorkLocations-v0, whose goal is a "
+                  "taught location's index",
         claims=(Claim(
             "multires", "\"arrival at the goal was generally recognized with an accuracy "
             "of 10 centimeters or better\" (§4 (1)); self-localisation at a work location "
@@ -414,6 +439,21 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
                       partial(_family_seeds, k, first_seed=VALIDATION_SEED), V2_SIMULATION)
               for k, name in enumerate(families_in("validation"))),
         FAMILY_METHODS, episodes=50),
+    Protocol(
+        "routes", 1, "RouteFollowing-v0 under the stop rule: Hong et al.'s 17 targets "
+        "1 ft apart in the hallway, and curved routes (route='random': 17 legs of 1 ft, "
+        "each turning by up to 30 degrees) drawn per episode in held-out worlds of "
+        "random_nature and random_rooms; success = stopped within 0.15 m of the last "
+        f"target after leaving every earlier one; seeds from {ROUTES_SEED}; ray cast, "
+        "1/120 s physics; LocalHoming policies home to the targets one by one",
+        (Setting("hallway, Hong's route", ROUTE,
+                 {"scene": "hallway", "success_radius": SUCCESS_RADIUS},
+                 partial(_route_seeds, 0), V2_SIMULATION),
+         *(Setting(f"{scene}, curved", ROUTE,
+                   {"scene": scene, "route": "random", "success_radius": SUCCESS_RADIUS},
+                   partial(_route_seeds, k), V2_SIMULATION)
+           for k, scene in enumerate(("random_nature", "random_rooms"), start=1))),
+        ROUTE_METHODS, episodes=10, policy_envs=(LOCAL,)),
 )}
 
 

@@ -13,6 +13,7 @@ import homing_gym  # noqa: F401
 from homing_gym.scenes.base import clearance
 from homing_train.harness import eval_command
 from homing_train.harness.evaluate import EpisodeRecord, summarize
+from homing_train.harness.policies import DEFAULT_POLICY
 from homing_train.harness.matrix import (Cell, cell_methods, equal_time_kwargs, run_cell,
                                          write_matrix)
 from homing_train.harness.protocols import (NEST, PROTOCOLS, marked_goal_starts, protocol,
@@ -94,9 +95,9 @@ def test_a_policy_keeps_its_own_renderer_and_physics():
 
 def test_protocols_pin_their_renderer_and_physics():
     """The protocols of homing-gym 0.1 (version 1) were measured with TinyRenderer and
-    1/240 s, their later versions and the protocols made since (the families' protocols) ray cast
+    1/240 s, their later versions and the protocols made since (the families', routes) ray cast
     at 1/120 s; both are explicit, so a change of the env defaults changes no cell."""
-    since_0_2 = {"unseen-families", "validation-families"}
+    since_0_2 = {"unseen-families", "validation-families", "routes"}
     for p in PROTOCOLS.values():
         for setting in p.settings:
             kwargs = setting.kwargs()
@@ -426,3 +427,26 @@ def test_the_families_protocols_hold_out_the_test_families_with_their_own_seeds(
              for seed, _, _ in s.episode_tasks(p.episodes, p.seed)]
     assert len(seeds) == len(set(seeds)) == 3 * 100 + 2 * 50
     assert all(s.env_kwargs["start_distance"] == [0.3, 2.0] for s in test.settings)
+
+
+def test_a_policy_row_says_why_it_is_empty_where_no_policy_can_act():
+    from homing_train.harness.matrix import matrix_markdown
+    assert not [m for m in cell_methods(protocol("hong1991")) if m.startswith("ppo")]
+    cells = [_cell("yukim", m, {"arena nest": (5, 10)}) for m in ("warping", DEFAULT_POLICY)]
+    cells.append(_cell("hong1991", "warping", {"hallway, 1 ft": (9, 10)}))
+    table = matrix_markdown(cells).split("\n\n")
+    rows = {line.split(" | ")[0][2:]: line for line in table[1].splitlines()[2:]}
+    assert rows[DEFAULT_POLICY].endswith("| n/a |")          # hong1991: it cannot drive it
+    assert rows["warping"].endswith("| 90 [60, 98] |")
+    assert table[2].startswith("n/a: no learned policy can act here. hong1991: the synchro")
+
+
+def test_the_routes_protocol_lets_localhoming_policies_follow_its_targets():
+    routes = protocol("routes")
+    assert {s.env_id for s in routes.settings} == {"homing_gym/RouteFollowing-v0"}
+    assert DEFAULT_POLICY in cell_methods(routes)
+    assert {"perfect-memory", "infomax", "min-warping"} <= set(cell_methods(routes))
+    assert [s.env_kwargs.get("route") for s in routes.settings] == [None, "random", "random"]
+    assert all(s.kwargs()["success_radius"] == 0.15 for s in routes.settings)
+    seeds = [seed for s in routes.settings for seed, _, _ in s.episode_tasks(10, routes.seed)]
+    assert len(set(seeds)) == 30 and min(seeds) == 60_000_000
