@@ -253,6 +253,9 @@ COMMON_SEED = 20_000_000
 FAMILIES_SEED = 30_000_000
 #: ``validation-families``' seeds.
 VALIDATION_SEED = 40_000_000
+#: ``train-families``' seeds: far beyond any training env's worlds (a training env ``i``
+#: draws worlds from seed ``seed + i`` on).
+TRAIN_FAMILIES_SEED = 50_000_000
 #: ``routes``' seeds: clear of every training seed and of every other protocol's.
 ROUTES_SEED = 60_000_000
 #: Every method that follows a route from pixels alone, and the policies.
@@ -438,6 +441,16 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
         tuple(Setting(name, LOCAL, {"scene": name, "start_distance": [0.3, 2.0]},
                       partial(_family_seeds, k, first_seed=VALIDATION_SEED), V2_SIMULATION)
               for k, name in enumerate(families_in("validation"))),
+        FAMILY_METHODS, episodes=50),
+    Protocol(
+        "train-families", 1, "the training families (:data:`~homing_gym.scenes.families."
+        f"FAMILIES`, role 'train'): {', '.join(families_in('train'))}, on worlds no "
+        f"training run draws (seeds from {TRAIN_FAMILIES_SEED}): how a method does where "
+        "the policies learnt, beside the validation and test families; otherwise as "
+        "unseen-families",
+        tuple(Setting(name, LOCAL, {"scene": name, "start_distance": [0.3, 2.0]},
+                      partial(_family_seeds, k, first_seed=TRAIN_FAMILIES_SEED), V2_SIMULATION)
+              for k, name in enumerate(families_in("train"))),
         FAMILY_METHODS, episodes=50),
     Protocol(
         "routes", 1, "RouteFollowing-v0 under the stop rule: Hong et al.'s 17 targets "

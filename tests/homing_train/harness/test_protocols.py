@@ -97,7 +97,7 @@ def test_protocols_pin_their_renderer_and_physics():
     """The protocols of homing-gym 0.1 (version 1) were measured with TinyRenderer and
     1/240 s, their later versions and the protocols made since (the families', routes) ray cast
     at 1/120 s; both are explicit, so a change of the env defaults changes no cell."""
-    since_0_2 = {"unseen-families", "validation-families", "routes"}
+    since_0_2 = {"unseen-families", "validation-families", "train-families", "routes"}
     for p in PROTOCOLS.values():
         for setting in p.settings:
             kwargs = setting.kwargs()
@@ -421,11 +421,13 @@ def test_the_families_protocols_hold_out_the_test_families_with_their_own_seeds(
     the validation ones; no seed is shared between two families or the two protocols."""
     from homing_gym.scenes.families import families_in
     test, validation = protocol("unseen-families"), protocol("validation-families")
+    train = protocol("train-families")
     assert [s.env_kwargs["scene"] for s in test.settings] == list(families_in("test"))
     assert [s.env_kwargs["scene"] for s in validation.settings] == list(families_in("validation"))
-    seeds = [seed for p in (test, validation) for s in p.settings
+    assert [s.env_kwargs["scene"] for s in train.settings] == list(families_in("train"))
+    seeds = [seed for p in (test, validation, train) for s in p.settings
              for seed, _, _ in s.episode_tasks(p.episodes, p.seed)]
-    assert len(seeds) == len(set(seeds)) == 3 * 100 + 2 * 50
+    assert len(seeds) == len(set(seeds)) == 3 * 100 + 2 * 50 + 6 * 50
     assert all(s.env_kwargs["start_distance"] == [0.3, 2.0] for s in test.settings)
 
 
