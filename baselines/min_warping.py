@@ -54,7 +54,9 @@ Our choices (where the papers leave room):
   a tie would read as "not moved") is a distance estimate in units of landmark distance (as Franz's ``rho``); the robot stops when it is ``<= rho_stop``
   (as :mod:`homing_baselines.warping` stops at ``rho = 0``), or after ``max_steps``.
 * The search is a numba kernel over ``alpha x psi x (allowed u, v pairs)``: about
-  ``n^4 / 4`` table look-ups (4.2 million for 64 columns).
+  ``n^4 / 4`` table look-ups (4.2 million for 64 columns), ordered so that the innermost
+  loop runs over ``psi`` on contiguous memory (vectorised; 2.4 times the speed of the
+  loop over ``v`` innermost, the same sums in the same order, so the same result).
 """
 
 from __future__ import annotations
@@ -204,24 +206,28 @@ def _pair_table(n: int, scales: tuple[float, ...]) -> tuple[np.ndarray, np.ndarr
 
 
 @njit(cache=True)
-def _search(Dext: np.ndarray, start: np.ndarray, vs: np.ndarray, ks: np.ndarray,
+def _search(Drev: np.ndarray, start: np.ndarray, vs: np.ndarray, ks: np.ndarray,
             n: int) -> np.ndarray:
-    """E[alpha, psi] = sum_u min_v D[k(u,v), u + alpha, v + alpha - psi] (indices mod n);
-    ``Dext`` is the stack with the any-scale plane appended and its current-column axis
-    repeated three times, so ``v + alpha - psi + n`` needs no modulo."""
+    """E[alpha, psi] = sum_u min_v D[k(u,v), u + alpha, v + alpha - psi] (indices mod n).
+    ``Drev`` is the stack with the any-scale plane appended and its current-column axis
+    repeated three times and reversed, so that for one ``(alpha, u, v)`` the values of
+    every ``psi`` lie side by side (``Drev[k, i, 2n - 1 - v - alpha + psi]``): the
+    innermost loop runs over ``psi`` on a contiguous row, which the compiler vectorises."""
     E = np.zeros((n, n))
+    best = np.empty(n)
     for a in range(n):
         for u in range(n):
             i = (u + a) % n
-            q0, q1 = start[u], start[u + 1]
+            q0 = start[u]
+            row, off = Drev[ks[q0], i], 2 * n - 1 - vs[q0] - a
             for p in range(n):
-                base = a - p + n
-                best = np.inf
-                for q in range(q0, q1):
-                    val = Dext[ks[q], i, vs[q] + base]
-                    if val < best:
-                        best = val
-                E[a, p] += best
+                best[p] = row[off + p]
+            for q in range(q0 + 1, start[u + 1]):
+                row, off = Drev[ks[q], i], 2 * n - 1 - vs[q] - a
+                for p in range(n):
+                    best[p] = min(best[p], row[off + p])
+            for p in range(n):
+                E[a, p] += best[p]
     return E
 
 
@@ -237,7 +243,8 @@ def min_warp(snapshot: np.ndarray, current: np.ndarray,
     D = scale_plane_stack(snapshot, current, config)
     start, vs, ks = _pair_table(n, scales)
     Dext = np.tile(np.concatenate([D, D.min(0)[None]]), (1, 1, 3))
-    E = _search(Dext, start, vs, np.where(ks < 0, len(scales), ks), n)
+    E = _search(np.ascontiguousarray(Dext[:, :, ::-1]), start, vs,
+                np.where(ks < 0, len(scales), ks), n)
     a, p = np.unravel_index(int(np.argmin(E)), E.shape)
     step = 2 * np.pi / n
     alpha, psi = (a + 0.5) * step, p * step

@@ -100,3 +100,22 @@ def test_config_and_image_checks():
         column_image(np.zeros((48, 256)))
     with pytest.raises(ValueError, match="same shape"):
         min_warp(np.zeros((24, 64)), np.zeros((24, 32)))
+
+
+def test_the_search_sums_each_columns_best_allowed_match():
+    # E[alpha, psi] = sum_u min_v D[k(u, v), u + alpha, v + alpha - psi], written out
+    from homing_baselines.min_warping import _pair_table, _search
+
+    n, rng = 16, np.random.default_rng(3)
+    config = MinWarpingConfig(n_columns=n)
+    scales = tuple(float(s) for s in config.scales)
+    D = rng.random((len(scales) + 1, n, n))              # the any-scale plane last
+    start, vs, ks = _pair_table(n, scales)
+    ks = np.where(ks < 0, len(scales), ks)
+    drev = np.ascontiguousarray(np.tile(D, (1, 1, 3))[:, :, ::-1])
+    E = _search(drev, start, vs, ks, n)
+    for a in range(n):
+        for p in range(n):
+            expected = sum(min(D[ks[q], (u + a) % n, (vs[q] + a - p) % n]
+                               for q in range(start[u], start[u + 1])) for u in range(n))
+            assert E[a, p] == pytest.approx(expected, rel=1e-12)
