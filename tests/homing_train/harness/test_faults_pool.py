@@ -192,7 +192,7 @@ def test_sigterm_to_homing_eval_ends_it_with_one_line_and_no_worker_traceback(tm
 def test_ctrl_c_while_the_workers_start_prints_no_worker_traceback(tmp_path):
     """Ctrl-C in a terminal signals the whole process group; workers still importing
     used to print a KeyboardInterrupt traceback each."""
-    process, _ = _start(tmp_path, 4, start_new_session=True)
+    process, _ = _start(tmp_path, 40, start_new_session=True)   # cannot end before the signal
     try:
         _wait_for(lambda: len(_workers_of(process.pid)) == 2, process)
         time.sleep(0.5)                                  # the workers are importing
