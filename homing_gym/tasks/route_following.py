@@ -275,20 +275,27 @@ class RouteFollowingTask(GoalReachingTask):
                              f"m ({BODY_RADIUS - free[k]:.3f} m short)")
 
     def _random_route(self, scene: Scene, rng: np.random.Generator) -> np.ndarray:
-        """A random route's poses (start point, then targets): the start drawn clear of
-        the jitter (:func:`sample_free_pose`), then :func:`random_route` at
-        ``clearance_margin``, redrawn while the grid the oracle plans on does not join
-        its points in order; ``ValueError`` naming the scene after 20 routes."""
+        """A random route's poses (start point, then targets): a start drawn clear of the
+        jitter (:func:`sample_free_pose`), then up to 25 tries of :func:`random_route` at
+        ``clearance_margin`` from it (a start in a small room may have no room for the
+        route), kept once the grid the oracle plans on joins its points in order; up to
+        40 starts, then ``ValueError`` naming the scene and the route."""
         margin, jitter = self.clearance_margin, self.start_jitter[0]
-        for _ in range(20):
+        for _ in range(40):
             start = sample_free_pose(scene, rng, margin + jitter * math.sqrt(2))
-            points = random_route(scene, start, rng, self.n_targets * self.spacing, margin,
-                                  legs=(self.spacing, self.spacing), max_turn=RANDOM_ROUTE_TURN)
+            try:
+                points = random_route(scene, start, rng, self.n_targets * self.spacing, margin,
+                                      legs=(self.spacing, self.spacing),
+                                      max_turn=RANDOM_ROUTE_TURN, max_restarts=25)
+            except ValueError:
+                continue
             if joined_in_order(scene, points, margin).all():
                 return route_poses(points)
-        raise ValueError(f"scene {scene.name!r}: no random route of {self.n_targets} legs of "
-                         f"{self.spacing} m whose points the oracle's grid joins at "
-                         f"{margin} m (tried 20); use fewer targets or a more open scene")
+        raise ValueError(f"scene {scene.name!r} of size {scene.size} m holds no random route "
+                         f"of {self.n_targets} legs of {self.spacing} m turning by up to "
+                         f"{math.degrees(RANDOM_ROUTE_TURN):.0f} deg with {margin} m of "
+                         f"clearance (40 starts tried); use fewer targets, a shorter spacing "
+                         f"or a more open scene")
 
     def sample_episode(self, scene: Scene, rng: np.random.Generator) -> Episode:
         if self.random_route:

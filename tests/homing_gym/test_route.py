@@ -187,8 +187,8 @@ def test_random_routes_teach_the_views_of_each_episodes_route(make_env):
 
 
 @pytest.mark.parametrize("kwargs, message", [
-    ({"scene": "arena", "n_targets": 40, "spacing": 2.0}, r"scene 'arena' .* cannot hold a "
-                                                          r"route of 80.0 m"),
+    ({"scene": "arena", "n_targets": 40, "spacing": 2.0}, r"scene 'arena' .* holds no random "
+                                                          r"route of 40 legs of 2.0 m"),
     ({"scene": "arena", "spacing": 0.08}, r"success_radius 0.1 m: a random route's start"),
 ])
 def test_random_routes_that_cannot_be_drawn_are_refused(kwargs, message):
