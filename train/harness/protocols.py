@@ -466,7 +466,27 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
                    {"scene": scene, "route": "random", "success_radius": SUCCESS_RADIUS},
                    partial(_route_seeds, k), V2_SIMULATION)
            for k, scene in enumerate(("random_nature", "random_rooms"), start=1))),
-        ROUTE_METHODS, episodes=10, policy_envs=(LOCAL,)),
+        ROUTE_METHODS, episodes=10, policy_envs=(LOCAL,),
+        claims=(
+            Claim("snapshot", "17 hallway images taken at targets about 1 ft apart; the "
+                  "robot, placed 1 ft from the first, homed to each in sequence and \"was "
+                  "able to traverse this path successfully and reach the final target "
+                  "location\"", "one route of 17 targets, no error figures",
+                  "Hong et al. 1991, §5",
+                  "the paper: one run on a real synchro-drive robot, no success radius "
+                  "stated; ours: our differential-drive robot, the last stop within "
+                  "0.15 m, the cell over all three settings of which the hallway is the "
+                  "paper's (per setting: docs/routes.md)", runs=(1, 1)),
+            *(Claim(method, "route navigation as \"a search for familiar views\" with \"a "
+                    "simple scanning routine\", tested \"by learning a series of routes "
+                    "through visually cluttered environments\": \"not only is the approach "
+                    "successful\", the routes learnt resemble desert ants'", "",
+                    "Baddeley et al. 2012, abstract",
+                    "the paper: an ant-sized agent in worlds of objects seen as silhouettes "
+                    "against the sky, judged on staying on the route (no stop, no targets); "
+                    "ours: textured procedural worlds and the hallway, a robot that must "
+                    "stop within 0.15 m of each target")
+              for method in ("perfect-memory", "infomax")))),
 )}
 
 
