@@ -81,13 +81,16 @@ class MinWarpingConfig:
     """Resolution of min-warping (module doc): ``n_columns`` bearing columns (also the
     ``alpha`` and ``psi`` grid), ``row_pairs`` (average rows in pairs), ``n_scales`` odd
     number of vertical scales geometric in ``[1/scale_max, scale_max]``, the vertical field
-    of view ``vfov_deg`` of the panorama."""
+    of view ``vfov_deg`` of the panorama, and ``psi_window_deg``: the width of the range of
+    rotations ``psi`` searched, centred on the compass estimate (:func:`compass_shift`;
+    360: every rotation)."""
 
     n_columns: int = 64
     row_pairs: bool = True
     n_scales: int = 9
     scale_max: float = 2.0
     vfov_deg: float = 60.0
+    psi_window_deg: float = 360.0
 
     def __post_init__(self) -> None:
         require_number("MinWarpingConfig: n_columns", self.n_columns, 8, 512, "columns",
@@ -101,6 +104,13 @@ class MinWarpingConfig:
                              f"them), got {self.n_scales!r}")
         require_number("MinWarpingConfig: scale_max", self.scale_max, 1, 10, low_open=True)
         require_number("MinWarpingConfig: vfov_deg", self.vfov_deg, 1, 179, "degrees")
+        require_number("MinWarpingConfig: psi_window_deg", self.psi_window_deg, 0, 360,
+                       "degrees", low_open=True)
+
+    def psi_window(self) -> int:
+        """How many rotation columns the search covers (odd, at most ``n_columns``)."""
+        count = 2 * int(round(self.psi_window_deg / 360 * self.n_columns / 2)) + 1
+        return min(count, self.n_columns)
 
     @property
     def scales(self) -> np.ndarray:
@@ -207,28 +217,43 @@ def _pair_table(n: int, scales: tuple[float, ...]) -> tuple[np.ndarray, np.ndarr
 
 @njit(cache=True)
 def _search(Drev: np.ndarray, start: np.ndarray, vs: np.ndarray, ks: np.ndarray,
-            n: int) -> np.ndarray:
-    """E[alpha, psi] = sum_u min_v D[k(u,v), u + alpha, v + alpha - psi] (indices mod n).
-    ``Drev`` is the stack with the any-scale plane appended and its current-column axis
-    repeated three times and reversed, so that for one ``(alpha, u, v)`` the values of
-    every ``psi`` lie side by side (``Drev[k, i, 2n - 1 - v - alpha + psi]``): the
-    innermost loop runs over ``psi`` on a contiguous row, which the compiler vectorises."""
-    E = np.zeros((n, n))
-    best = np.empty(n)
+            n: int, p_lo: int, count: int) -> np.ndarray:
+    """E[alpha, psi] = sum_u min_v D[k(u,v), u + alpha, v + alpha - psi] (indices mod n)
+    for the ``count`` rotations ``psi = p_lo, p_lo + 1, ...`` (mod n; the others stay
+    ``inf``). ``Drev`` is the stack with the any-scale plane appended and its
+    current-column axis repeated four times and reversed, so that for one
+    ``(alpha, u, v)`` the values of consecutive ``psi`` lie side by side
+    (``Drev[k, i, 2n - 1 - v - alpha + psi]``, ``psi < 2n``): the innermost loop runs
+    over ``psi`` on a contiguous row, which the compiler vectorises."""
+    E = np.full((n, n), np.inf)
+    best = np.empty(count)
     for a in range(n):
+        total = np.zeros(count)
         for u in range(n):
             i = (u + a) % n
             q0 = start[u]
-            row, off = Drev[ks[q0], i], 2 * n - 1 - vs[q0] - a
-            for p in range(n):
+            row, off = Drev[ks[q0], i], 2 * n - 1 - vs[q0] - a + p_lo
+            for p in range(count):
                 best[p] = row[off + p]
             for q in range(q0 + 1, start[u + 1]):
-                row, off = Drev[ks[q], i], 2 * n - 1 - vs[q] - a
-                for p in range(n):
+                row, off = Drev[ks[q], i], 2 * n - 1 - vs[q] - a + p_lo
+                for p in range(count):
                     best[p] = min(best[p], row[off + p])
-            for p in range(n):
-                E[a, p] += best[p]
+            for p in range(count):
+                total[p] += best[p]
+        for p in range(count):
+            E[a, (p_lo + p) % n] = total[p]
     return E
+
+
+def compass_shift(D: np.ndarray, scales: np.ndarray) -> int:
+    """The rotation ``psi`` (columns) that best aligns the two images as if the robot had
+    not moved: ``argmin_psi sum_i D[sigma = 1, i, i - psi]`` (the unscaled plane of the
+    stack), the centre of the rotations searched when ``psi_window_deg`` < 360."""
+    n = D.shape[1]
+    plane = D[int(np.argmin(np.abs(np.log(scales))))]
+    i = np.arange(n)
+    return int(np.argmin(plane[i[:, None], (i[:, None] - i[None, :]) % n].sum(0)))
 
 
 def min_warp(snapshot: np.ndarray, current: np.ndarray,
@@ -242,9 +267,11 @@ def min_warp(snapshot: np.ndarray, current: np.ndarray,
     scales = tuple(float(s) for s in config.scales)
     D = scale_plane_stack(snapshot, current, config)
     start, vs, ks = _pair_table(n, scales)
-    Dext = np.tile(np.concatenate([D, D.min(0)[None]]), (1, 1, 3))
+    Dext = np.tile(np.concatenate([D, D.min(0)[None]]), (1, 1, 4))
+    count = config.psi_window()
+    p_lo = 0 if count == n else (compass_shift(D, config.scales) - count // 2) % n
     E = _search(np.ascontiguousarray(Dext[:, :, ::-1]), start, vs,
-                np.where(ks < 0, len(scales), ks), n)
+                np.where(ks < 0, len(scales), ks), n, p_lo, count)
     a, p = np.unravel_index(int(np.argmin(E)), E.shape)
     step = 2 * np.pi / n
     alpha, psi = (a + 0.5) * step, p * step
@@ -283,6 +310,7 @@ class MinWarpingController(Controller):
     n_columns: int = MinWarpingConfig.n_columns
     n_scales: int = MinWarpingConfig.n_scales
     scale_max: float = MinWarpingConfig.scale_max
+    psi_window_deg: float = MinWarpingConfig.psi_window_deg
 
     def validate(self) -> None:
         require_positive("min-warping: step_length", self.step_length, "metres")
@@ -290,7 +318,8 @@ class MinWarpingController(Controller):
         require_number("min-warping: max_steps", self.max_steps, 1, 100_000, integer=True)
         try:
             self.config = MinWarpingConfig(n_columns=self.n_columns, n_scales=self.n_scales,
-                                           scale_max=self.scale_max)
+                                           scale_max=self.scale_max,
+                                           psi_window_deg=self.psi_window_deg)
         except ValueError as err:
             raise ValueError(f"min-warping: {err}") from None
 

@@ -112,10 +112,28 @@ def test_the_search_sums_each_columns_best_allowed_match():
     D = rng.random((len(scales) + 1, n, n))              # the any-scale plane last
     start, vs, ks = _pair_table(n, scales)
     ks = np.where(ks < 0, len(scales), ks)
-    drev = np.ascontiguousarray(np.tile(D, (1, 1, 3))[:, :, ::-1])
-    E = _search(drev, start, vs, ks, n)
+    drev = np.ascontiguousarray(np.tile(D, (1, 1, 4))[:, :, ::-1])
+    E = _search(drev, start, vs, ks, n, 0, n)
     for a in range(n):
         for p in range(n):
             expected = sum(min(D[ks[q], (u + a) % n, (vs[q] + a - p) % n]
                                for q in range(start[u], start[u + 1])) for u in range(n))
             assert E[a, p] == pytest.approx(expected, rel=1e-12)
+    window = _search(drev, start, vs, ks, n, 13, 5)        # psi 13, 14, 15, 0, 1 (mod 16)
+    searched = [13, 14, 15, 0, 1]
+    assert np.array_equal(window[:, searched], E[:, searched])
+    assert np.isinf(np.delete(window, searched, axis=1)).all()
+
+
+def test_the_compass_finds_a_pure_rotation_and_centres_the_window_on_it(panorama_at):
+    from homing_baselines.min_warping import compass_shift, min_warp, scale_plane_stack
+
+    config = MinWarpingConfig()
+    home = column_image(panorama_at((0.3, -0.2, 0.0)), config)
+    turned = column_image(panorama_at((0.3, -0.2, 2 * math.pi * 10 / 64)), config)
+    D = scale_plane_stack(home, turned, config)
+    assert compass_shift(D, config.scales) == 10
+    full = min_warp(home, turned, config)
+    narrow = min_warp(home, turned, MinWarpingConfig(psi_window_deg=45.0))
+    assert narrow.psi == pytest.approx(full.psi) and narrow.alpha == pytest.approx(full.alpha)
+    assert np.isfinite(narrow.costs).sum() == 64 * 9              # 45 deg: 9 of 64 columns
