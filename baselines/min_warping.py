@@ -53,6 +53,10 @@ Our choices (where the papers leave room):
   (those whose allowed matches do not all cost the same: a uniform wall column ties, and
   a tie would read as "not moved") is a distance estimate in units of landmark distance (as Franz's ``rho``); the robot stops when it is ``<= rho_stop``
   (as :mod:`homing_baselines.warping` stops at ``rho = 0``), or after ``max_steps``.
+* Compass-restricted search (the papers' acceleration): with ``psi_window_deg`` < 360
+  only the rotations within half the window of a compass estimate are searched, the
+  estimate being the rotation that best aligns the two images as if the robot had not
+  moved (:func:`compass_shift`, on the stack's unscaled plane, which is computed anyway).
 * The search is a numba kernel over ``alpha x psi x (allowed u, v pairs)``: about
   ``n^4 / 4`` table look-ups (4.2 million for 64 columns), ordered so that the innermost
   loop runs over ``psi`` on contiguous memory (vectorised; 2.4 times the speed of the
