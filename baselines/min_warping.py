@@ -306,15 +306,21 @@ class MinWarpingController(Controller):
     """Min-warping homing (module doc): each decision runs :func:`min_warp` on the current
     panorama and the goal and moves ``step_length`` m in the home direction; it stops
     when the displacement estimate ``rho`` is at most ``rho_stop`` or after ``max_steps``
-    moves. The resolution fields are :class:`MinWarpingConfig`'s."""
+    moves. The resolution fields are :class:`MinWarpingConfig`'s.
+
+    Defaults chosen on the validation families (``validation-families``: `labs`, `rocky`,
+    100 episodes, success under the stop rule): 64 columns 46 % (rocky 6 %: the robot
+    stops 0.15-0.3 m short, where distant objects no longer move by a 5.6 degree column),
+    96 columns 53 %, 128 columns 65 %, 128 columns with ``psi_window_deg`` = 90 65 % at
+    about half the search time; so 128 columns and a 90 degree window."""
 
     step_length: float = 0.1
     rho_stop: float = 0.0
     max_steps: int = 60
-    n_columns: int = MinWarpingConfig.n_columns
+    n_columns: int = 128
     n_scales: int = MinWarpingConfig.n_scales
     scale_max: float = MinWarpingConfig.scale_max
-    psi_window_deg: float = MinWarpingConfig.psi_window_deg
+    psi_window_deg: float = 90.0
 
     def validate(self) -> None:
         require_positive("min-warping: step_length", self.step_length, "metres")
