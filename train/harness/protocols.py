@@ -241,7 +241,9 @@ FOOT = 0.3048
 NEST = (0.0, 0.0, 0.0)
 LOCAL = "homing_gym/LocalHoming-v0"
 ROUTE = "homing_gym/RouteFollowing-v0"
-HOMING_METHODS = ("oracle", "random", "snapshot", "warping", "distance", POLICIES)
+#: Every classical method that runs LocalHoming from pixels alone, and the policies.
+HOMING_METHODS = ("oracle", "random", "snapshot", "warping", "min-warping", "distance", "alv",
+                  "did", POLICIES)
 #: Held out from every shipped policy's training: seeds of the procedural worlds far from
 #: the training seeds, and scenes it never saw.
 UNSEEN_SEED = 10_000_000
@@ -261,9 +263,6 @@ ROUTES_SEED = 60_000_000
 #: Every method that follows a route from pixels alone, and the policies.
 ROUTE_METHODS = ("oracle", "random", "snapshot", "warping", "min-warping", "did",
                  "perfect-memory", "infomax", POLICIES)
-#: Every classical method that runs LocalHoming from pixels alone, and the policies.
-FAMILY_METHODS = ("oracle", "random", "snapshot", "warping", "min-warping", "distance", "alv",
-                  "did", POLICIES)
 #: The worlds of ``local-common`` v2: the paper scenes and the procedural worlds.
 COMMON_SCENES = ("arena", "hallway", "lab", "house", "random_rooms", "random_nature")
 PROCEDURAL = ("random_arena", "random_rooms", "random_nature")
@@ -432,7 +431,7 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
         tuple(Setting(name, LOCAL, {"scene": name, "start_distance": [0.3, 2.0]},
                       partial(_family_seeds, k), V2_SIMULATION)
               for k, name in enumerate(families_in("test"))),
-        FAMILY_METHODS, episodes=100),
+        HOMING_METHODS, episodes=100),
     Protocol(
         "validation-families", 1, "the validation families (:data:`~homing_gym.scenes."
         f"families.FAMILIES`, role 'validation'): {', '.join(families_in('validation'))}, "
@@ -441,7 +440,7 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
         tuple(Setting(name, LOCAL, {"scene": name, "start_distance": [0.3, 2.0]},
                       partial(_family_seeds, k, first_seed=VALIDATION_SEED), V2_SIMULATION)
               for k, name in enumerate(families_in("validation"))),
-        FAMILY_METHODS, episodes=50),
+        HOMING_METHODS, episodes=50),
     Protocol(
         "train-families", 1, "the training families (:data:`~homing_gym.scenes.families."
         f"FAMILIES`, role 'train'): {', '.join(families_in('train'))}, on worlds no "
@@ -451,7 +450,7 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
         tuple(Setting(name, LOCAL, {"scene": name, "start_distance": [0.3, 2.0]},
                       partial(_family_seeds, k, first_seed=TRAIN_FAMILIES_SEED), V2_SIMULATION)
               for k, name in enumerate(families_in("train"))),
-        FAMILY_METHODS, episodes=50),
+        HOMING_METHODS, episodes=50),
     Protocol(
         "routes", 1, "RouteFollowing-v0 under the stop rule: Hong et al.'s 17 targets "
         "1 ft apart in the hallway, and curved routes (route='random': 17 legs of 1 ft, "

@@ -28,8 +28,9 @@ def test_the_headline_plan_is_the_held_out_worlds_and_the_papers_protocols():
                      "briggs-corridors", "shiraishi-house"]
     classical = {m for p in plan.protocols for m in cell_methods(p)
                  if m in homing_baselines.available()}
-    assert classical == {"oracle", "random", "snapshot", "warping", "distance", "bearing",
-                         "bearing-basic", "bearing-complementary", "selfsimilar", "multires"}
+    assert classical == {"oracle", "random", "snapshot", "warping", "min-warping", "distance",
+                         "alv", "did", "bearing", "bearing-basic", "bearing-complementary",
+                         "selfsimilar", "multires"}
     learned = [m for m in plan.methods if m not in homing_baselines.available()]
     assert set(plan.methods) == classical | {DEFAULT_POLICY} and learned == [DEFAULT_POLICY]
     assert DEFAULT_POLICY in shipped_policies()
