@@ -181,6 +181,9 @@ def main(argv: list[str] | None = None) -> int:
     add_backend_arguments(parser)
     args = parser.parse_args(argv)
     check_backend_arguments(parser, args)
+    if args.methods:                                  # the alias of the default policy
+        args.methods = list(dict.fromkeys(DEFAULT_POLICY if m == "ppo" else m
+                                          for m in args.methods))
     if args.episodes is not None and args.episodes < 1:
         parser.error("--episodes must be >= 1")
     one_env = [flag for flag, value in (("--env", args.env), ("--env-kwargs", args.env_kwargs),

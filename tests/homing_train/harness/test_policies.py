@@ -33,3 +33,15 @@ def test_ppo_and_shipped_names_are_policies():
     with pytest.raises(ValueError, match=r"unknown policy 'ppo_localhoming'.*a shipped policy "
                        r"\['ppo', 'ppo_procedural_imitation', 'ppo_procedural_long'\]"):
         policy_spec("ppo_localhoming")
+
+
+def test_ppo_is_the_default_policy_in_the_suite_and_in_a_protocol_cell(tmp_path, capsys):
+    from homing_train.harness import suite
+    from homing_train.harness.matrix import run_cell
+    from homing_train.harness.protocols import protocol
+
+    assert suite.main(["--scene", "arena", "--methods", "ppo", "--episodes", "1", "--workers",
+                       "1", "--out", str(tmp_path / "suite")]) == 0
+    assert (tmp_path / "suite" / f"{DEFAULT_POLICY}.json").exists()
+    cell = run_cell(protocol("yukim"), "ppo", tmp_path / "cell", episodes=1, progress=False)
+    assert cell.method == DEFAULT_POLICY and f"--policy {DEFAULT_POLICY}" in cell.command
