@@ -66,7 +66,7 @@ Our choices (where the papers leave room):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 
 import cv2
@@ -78,6 +78,10 @@ from homing_baselines.motion import Move
 from homing_gym.geometry import wrap_angle
 from homing_gym.validation import require_number, require_positive
 from homing_gym.vision import luminance
+
+
+#: The controller's number of bearing columns where the panorama is at least as wide.
+DEFAULT_COLUMNS = 128
 
 
 @dataclass(frozen=True)
@@ -312,12 +316,15 @@ class MinWarpingController(Controller):
     100 episodes, success under the stop rule): 64 columns 46 % (rocky 6 %: the robot
     stops 0.15-0.3 m short, where distant objects no longer move by a 5.6 degree column),
     96 columns 53 %, 128 columns 65 %, 128 columns with ``psi_window_deg`` = 90 65 % at
-    about half the search time; so 128 columns and a 90 degree window."""
+    about half the search time; so 128 columns and a 90 degree window. ``n_columns=None``
+    (the default) is :data:`DEFAULT_COLUMNS`, or the panorama's width (rounded down to
+    even) where it is narrower; a number given is used as it is (a panorama narrower than
+    it is a ``ValueError``)."""
 
     step_length: float = 0.1
     rho_stop: float = 0.0
     max_steps: int = 60
-    n_columns: int = 128
+    n_columns: int | None = None
     n_scales: int = MinWarpingConfig.n_scales
     scale_max: float = MinWarpingConfig.scale_max
     psi_window_deg: float = 90.0
@@ -327,11 +334,18 @@ class MinWarpingController(Controller):
         require_number("min-warping: rho_stop", self.rho_stop, 0, 1, high_open=True)
         require_number("min-warping: max_steps", self.max_steps, 1, 100_000, integer=True)
         try:
-            self.config = MinWarpingConfig(n_columns=self.n_columns, n_scales=self.n_scales,
-                                           scale_max=self.scale_max,
+            self.config = MinWarpingConfig(n_columns=(DEFAULT_COLUMNS if self.n_columns is None
+                                                      else self.n_columns),
+                                           n_scales=self.n_scales, scale_max=self.scale_max,
                                            psi_window_deg=self.psi_window_deg)
         except ValueError as err:
             raise ValueError(f"min-warping: {err}") from None
+
+    def _config_for(self, width: int) -> MinWarpingConfig:
+        """The resolution for panoramas ``width`` columns wide (see the class doc)."""
+        if self.n_columns is not None:
+            return self.config
+        return replace(self.config, n_columns=max(8, min(DEFAULT_COLUMNS, width - width % 2)))
 
     def on_reset(self) -> None:
         self._goal: np.ndarray | None = None
@@ -343,6 +357,7 @@ class MinWarpingController(Controller):
         goal = observation["goal"]
         if self._goal is None or not np.array_equal(goal, self._goal):
             self._goal = np.array(goal, copy=True)        # a new target: a new snapshot
+            self.config = self._config_for(goal.shape[1])
             self._snapshot = column_image(goal, self.config)
             self._steps, self._stopped = 0, False
         if self._stopped or self._steps >= self.max_steps:

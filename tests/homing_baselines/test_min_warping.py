@@ -138,3 +138,17 @@ def test_the_compass_finds_a_pure_rotation_and_centres_the_window_on_it(panorama
     narrow = min_warp(home, turned, MinWarpingConfig(psi_window_deg=45.0))
     assert narrow.psi == pytest.approx(full.psi) and narrow.alpha == pytest.approx(full.alpha)
     assert np.isfinite(narrow.costs).sum() == 64 * 9              # 45 deg: 9 of 64 columns
+
+
+def test_the_default_resolution_follows_a_narrower_panorama_and_a_given_one_does_not():
+    rng = np.random.default_rng(0)
+    narrow = {"panorama": rng.integers(0, 255, (16, 64, 3), np.uint8),
+              "goal": rng.integers(0, 255, (16, 64, 3), np.uint8)}
+    controller = MinWarpingController()
+    controller.reset(0)
+    controller.decide(narrow)
+    assert controller.config.n_columns == 64 and controller.last_result.costs.shape == (64, 64)
+    given = MinWarpingController(n_columns=128)
+    given.reset(0)
+    with pytest.raises(ValueError, match="n_columns=128"):
+        given.decide(narrow)
