@@ -25,8 +25,9 @@ from homing_train.harness.protocols import PROTOCOLS, Protocol
 #: cost of a cell (CPU seconds per episode, summed over its methods, with ``random``
 #: running to the step cap: about 29 per setting in ``unseen``, 27 in ``local-common``,
 #: 6 in ``hong1991``, 10 in ``yukim``, 14 in ``bekris-lab``, 31 in ``briggs-corridors``
-#: (3,000 steps), 64 in ``shiraishi-house`` (1,500 steps in the house)): about 370 CPU
-#: seconds in all, under 4 minutes with 2 processes.
+#: (3,000 steps), 64 in ``shiraishi-house`` (1,500 steps in the house)), before
+#: min-warping, alv and did joined ``unseen`` and ``local-common``: now about 450 CPU
+#: seconds in all, 4 minutes with 2 processes.
 HEADLINE_EPISODES: dict[str, int] = {
     "unseen": 2, "local-common": 1, "hong1991": 6, "yukim": 4, "bekris-lab": 6,
     "briggs-corridors": 2, "shiraishi-house": 1}
