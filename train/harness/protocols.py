@@ -282,6 +282,14 @@ def _family_seeds(k: int, episodes: int, seed: int, first_seed: int = 0) -> list
     return [(first + i, None, None) for i in range(episodes)]
 
 
+def _family_settings(role: str, first_seed: int = 0) -> tuple[Setting, ...]:
+    """One LocalHoming setting per family of ``role`` (homes anywhere, starts 0.3-2.0 m,
+    ray cast), the ``k``-th drawing its seeds from ``first_seed`` (:func:`_family_seeds`)."""
+    return tuple(Setting(name, LOCAL, {"scene": name, "start_distance": [0.3, 2.0]},
+                         partial(_family_seeds, k, first_seed=first_seed), V2_SIMULATION)
+                 for k, name in enumerate(families_in(role)))
+
+
 def _route_seeds(k: int, episodes: int, seed: int) -> list[Task]:
     """Seeds from :data:`ROUTES_SEED` on for ``routes``' ``k``-th setting, a million
     apart from the next setting's."""
@@ -428,29 +436,20 @@ PROTOCOLS: dict[str, Protocol] = {p.name: p for p in (
         f"homes anywhere, starts 0.3-2.0 m, seeds from {FAMILIES_SEED} (a million apart per "
         "family); ray cast, 1/120 s "
         "physics",
-        tuple(Setting(name, LOCAL, {"scene": name, "start_distance": [0.3, 2.0]},
-                      partial(_family_seeds, k), V2_SIMULATION)
-              for k, name in enumerate(families_in("test"))),
-        HOMING_METHODS, episodes=100),
+        _family_settings("test"), HOMING_METHODS, episodes=100),
     Protocol(
         "validation-families", 1, "the validation families (:data:`~homing_gym.scenes."
         f"families.FAMILIES`, role 'validation'): {', '.join(families_in('validation'))}, "
         "for choosing recipes and checkpoints (never the test families); otherwise as "
         f"unseen-families, seeds from {VALIDATION_SEED}",
-        tuple(Setting(name, LOCAL, {"scene": name, "start_distance": [0.3, 2.0]},
-                      partial(_family_seeds, k, first_seed=VALIDATION_SEED), V2_SIMULATION)
-              for k, name in enumerate(families_in("validation"))),
-        HOMING_METHODS, episodes=50),
+        _family_settings("validation", VALIDATION_SEED), HOMING_METHODS, episodes=50),
     Protocol(
         "train-families", 1, "the training families (:data:`~homing_gym.scenes.families."
         f"FAMILIES`, role 'train'): {', '.join(families_in('train'))}, on worlds no "
         f"training run draws (seeds from {TRAIN_FAMILIES_SEED}): how a method does where "
         "the policies learnt, beside the validation and test families; otherwise as "
         "unseen-families",
-        tuple(Setting(name, LOCAL, {"scene": name, "start_distance": [0.3, 2.0]},
-                      partial(_family_seeds, k, first_seed=TRAIN_FAMILIES_SEED), V2_SIMULATION)
-              for k, name in enumerate(families_in("train"))),
-        HOMING_METHODS, episodes=50),
+        _family_settings("train", TRAIN_FAMILIES_SEED), HOMING_METHODS, episodes=50),
     Protocol(
         "routes", 1, "RouteFollowing-v0 under the stop rule: Hong et al.'s 17 targets "
         "1 ft apart in the hallway, and curved routes (route='random': 17 legs of 1 ft, "
