@@ -275,17 +275,19 @@ def min_warp(snapshot: np.ndarray, current: np.ndarray,
     scales = tuple(float(s) for s in config.scales)
     D = scale_plane_stack(snapshot, current, config)
     start, vs, ks = _pair_table(n, scales)
-    Dext = np.tile(np.concatenate([D, D.min(0)[None]]), (1, 1, 4))
+    Dall = np.concatenate([D, D.min(0)[None]])
     count = config.psi_window()
     p_lo = 0 if count == n else (compass_shift(D, config.scales) - count // 2) % n
-    E = _search(np.ascontiguousarray(Dext[:, :, ::-1]), start, vs,
+    # the reversed stack repeated four times (period n: the same as repeating, then
+    # reversing), in one contiguous copy
+    E = _search(np.tile(Dall[:, :, ::-1], (1, 1, 4)), start, vs,
                 np.where(ks < 0, len(scales), ks), n, p_lo, count)
     a, p = np.unravel_index(int(np.argmin(E)), E.shape)
     step = 2 * np.pi / n
     alpha, psi = (a + 0.5) * step, p * step
     # the matched columns at the optimum: per-column displacement ratios d / r
     u_of = np.repeat(np.arange(n), np.diff(start))
-    vals = Dext[np.where(ks < 0, len(scales), ks), (u_of + a) % n, (vs + a - p) % n]
+    vals = Dall[np.where(ks < 0, len(scales), ks), (u_of + a) % n, (vs + a - p) % n]
     group_min = np.minimum.reduceat(vals, start[:-1])
     hit = np.flatnonzero(vals <= group_min[u_of])
     _, first = np.unique(u_of[hit], return_index=True)
