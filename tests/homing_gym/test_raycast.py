@@ -100,6 +100,41 @@ def test_an_image_does_not_depend_on_the_images_rendered_before_it():
     assert not np.array_equal(lit, first)
 
 
+def test_casters_sharing_a_thread_or_not_give_the_pixels_each_gives_alone():
+    """Casters of one thread share their scratch buffers: a textured world with shadows
+    and an untextured one rendered in turn, and each in its own thread at the same
+    time, give the images each gives when it is the only caster; the buffers are one
+    set per thread."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from homing_gym.render.panorama import CameraConfig
+    from homing_gym.render.raycast import scratch_buffers
+    from homing_gym.render.worldmesh import world_mesh
+    from homing_gym.scenes import scene_factory
+
+    rng = np.random.default_rng(0)
+    hallway = RayCaster(world_mesh(scene_factory("hallway").build(rng)), shadows=True)
+    pole = RayCaster(world_mesh(_pole_scene(1.0, 0.5)))
+    config = CameraConfig()
+    poses = [(0.2 * k, 0.1 * k, 0.7 * k) for k in range(4)]
+    alone = {id(c): [c.panorama(p, 0.3, config) for p in poses] for c in (hallway, pole)}
+    in_turn = {id(c): [] for c in (hallway, pole)}
+    for p in poses:
+        for c in (pole, hallway):
+            in_turn[id(c)].append(c.panorama(p, 0.3, config))
+    with ThreadPoolExecutor(2) as pool:
+        threads = {id(c): pool.submit(lambda c=c: [c.panorama(p, 0.3, config) for p in poses])
+                   for c in (hallway, pole)}
+        threaded = {key: future.result() for key, future in threads.items()}
+        elsewhere = pool.submit(scratch_buffers, 96, 512).result()[0]
+    for key, images in alone.items():
+        assert all(np.array_equal(a, b) for a, b in zip(images, in_turn[key]))
+        assert all(np.array_equal(a, b) for a, b in zip(images, threaded[key]))
+    assert not np.array_equal(alone[id(hallway)][0], alone[id(pole)][0])
+    assert scratch_buffers(96, 512)[0] is scratch_buffers(96, 512)[0]
+    assert elsewhere is not scratch_buffers(96, 512)[0]
+
+
 def test_the_caster_search_finds_the_first_value_past_a_bound_from_any_guess():
     rng = np.random.default_rng(0)
     for _ in range(3000):
