@@ -134,14 +134,9 @@ class EnvBatch:
         self.action_space = first.action_space
         self._threads = threads
         self._pool = ThreadPoolExecutor(threads, "homing-render") if threads > 1 else None
-        self._builder = None
-        prebuilt = [env for env in self.envs if isinstance(env.scene_spec, str)
-                    and env.draws_worlds and env.sim.caster is not None]
-        if prebuild_worlds and prebuilt:
-            self._builder = WorldBuilder()
-            for env in prebuilt:
-                env.world_source = self._builder.source(env.scene_spec, env.config.sky_color,
-                                                        env.config.shadows)
+        self._builder: WorldBuilder | None = None
+        if prebuild_worlds and self.prebuildable:
+            self.use_builder(WorldBuilder())
         self._elapsed = np.zeros(self.num_envs, np.int64)
         self._autoreset = np.zeros(self.num_envs, np.bool_)
         self.obs: list[dict[str, np.ndarray] | None] = [None] * self.num_envs
@@ -253,6 +248,26 @@ class EnvBatch:
     def stacked_obs(self) -> dict[str, np.ndarray]:
         """The envs' latest observations as one batch (each key ``(N, ...)``)."""
         return stacked(self.obs)
+
+    @property
+    def prebuildable(self) -> list[HomingEnv]:
+        """The envs whose new worlds a :class:`~homing_gym.vector.worlds.WorldBuilder`
+        can build: a registered procedural scene (by name) and the ray caster."""
+        return [env for env in self.envs if isinstance(env.scene_spec, str)
+                and env.draws_worlds and env.sim.caster is not None]
+
+    def use_builder(self, builder: WorldBuilder) -> None:
+        """Have ``builder`` build the new worlds of the :attr:`prebuildable` envs ahead
+        of need (closed with the batch)."""
+        self._builder = builder
+        for env in self.prebuildable:
+            env.world_source = builder.source(env.scene_spec, env.config.sky_color,
+                                              env.config.shadows)
+
+    @property
+    def worlds_served(self) -> int:
+        """New worlds the envs took from the builder so far (0 without one)."""
+        return 0 if self._builder is None else self._builder.served
 
     def close(self) -> None:
         """Close every env and stop the render threads; safe to call more than once."""

@@ -29,8 +29,8 @@ from homing_gym.scenes import scene_factory
 
 @dataclass(frozen=True)
 class VectorResult:
-    """One configuration's env steps per second (median over rounds); for vector envs in
-    one process also their step times (seconds) and the share of them spent in resets;
+    """One configuration's env steps per second (median over rounds); for vector envs
+    also their step times (seconds), in one process the share of them spent in resets;
     for the single env the time (seconds per step) in PyBullet's physics (the sub-steps,
     motor updates and contact checks) and in rendering."""
 
@@ -96,7 +96,7 @@ def run(worlds: dict[str, dict], num_envs: int, processes: list[int], steps: int
                    for p in processes}
         rng = np.random.default_rng(0)
         rates: dict[str, list[float]] = {"single": [], **{f"native x{p}": [] for p in processes}}
-        times: list[float] = []
+        times: dict[int, list[float]] = {p: [] for p in processes}    # vector steps (s)
         resets = [0.0, 0.0]                     # seconds resetting, seconds stepping
         try:
             for v in vectors.values():
@@ -118,8 +118,7 @@ def run(worlds: dict[str, dict], num_envs: int, processes: list[int], steps: int
                     for _ in range(max(steps // num_envs, 1)):
                         t0 = time.perf_counter()
                         v.step(_actions(v.single_action_space, num_envs, p_stop, rng))
-                        if p == 1:
-                            times.append(time.perf_counter() - t0)
+                        times[p].append(time.perf_counter() - t0)
                     elapsed = time.perf_counter() - start
                     rates[f"native x{p}"].append(max(steps // num_envs, 1) * num_envs / elapsed)
                     if p == 1:
@@ -132,13 +131,12 @@ def run(worlds: dict[str, dict], num_envs: int, processes: list[int], steps: int
         results.append(VectorResult(world, "single", float(np.median(rates.pop("single"))),
                                     physics_s=physics.seconds / single_steps,
                                     render_s=render.seconds / single_steps))
-        for name, values in rates.items():
-            timed = name == "native x1" and times
+        for p in processes:
+            step_times = times[p]
             results.append(VectorResult(
-                world, name, float(np.median(values)),
-                float(np.median(times)) if timed else None,
-                float(np.percentile(times, 99)) if timed else None,
-                resets[0] / resets[1] if timed else None))
+                world, f"native x{p}", float(np.median(rates[f"native x{p}"])),
+                float(np.median(step_times)), float(np.percentile(step_times, 99)),
+                resets[0] / resets[1] if p == 1 else None))
     return results
 
 
@@ -156,9 +154,10 @@ def table(results: list[VectorResult], num_envs: int) -> str:
         config = (r.config if r.config == "single" else
                   f"native, {num_envs} envs in {r.config.split('x')[1]} process"
                   + ("es" if r.config != "native x1" else ""))
+        share = "-" if r.reset_share is None else f"{100 * r.reset_share:.0f}%"
         timing = ("| - | - | - | - |" if r.step_p50 is None else
                   f"| {1e3 * r.step_p50:.2f} | {1e3 * r.step_p99:.2f} | "
-                  f"{r.step_p99 / r.step_p50:.2f} | {100 * r.reset_share:.0f}% |")
+                  f"{r.step_p99 / r.step_p50:.2f} | {share} |")
         lines.append(f"| {r.world} | {config} | {r.steps_per_s:.0f} | "
                      f"{r.steps_per_s / single[r.world]:.2f}x {timing}")
     return "\n".join(lines + [""] + split)

@@ -64,9 +64,9 @@ class NativeVectorEnv(gym.vector.VectorEnv):
     keep one observation and action space (else ``ValueError``). ``processes``: 1 (the
     default) steps every env in this process; ``K > 1`` spreads them over ``K`` worker
     processes (:class:`~homing_gym.vector.processes.ProcessBatch`). ``threads``: render
-    threads per process (default: the cores over the processes). ``prebuild_worlds``
-    (one process only): a procedural scene's new worlds are built ahead of need in a
-    background process (:mod:`homing_gym.vector.worlds`)."""
+    threads per process (default: the cores over the processes). ``prebuild_worlds``:
+    a procedural scene's new worlds are built ahead of need in a background process
+    (:mod:`homing_gym.vector.worlds`; one per worker process with ``processes`` > 1)."""
 
     def __init__(self, env_id: str, num_envs: int = 1, *,
                  max_episode_steps: int | None = None,
@@ -102,7 +102,8 @@ class NativeVectorEnv(gym.vector.VectorEnv):
                                prebuild_worlds=prebuild_worlds)
                       if processes == 1 else
                       ProcessBatch(makers, processes, threads=threads,
-                                   max_episode_steps=limit, mode=mode))
+                                   max_episode_steps=limit, mode=mode,
+                                   prebuild_worlds=prebuild_worlds))
         self.max_episode_steps = limit
         self.metadata = {**getattr(_creator(env_id), "metadata", {}), "autoreset_mode": mode}
         self.autoreset_mode = mode

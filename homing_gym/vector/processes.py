@@ -26,6 +26,7 @@ from gymnasium.vector import AutoresetMode
 
 from homing_gym.env import HomingEnv
 from homing_gym.vector.batch import EnvBatch, EnvFailedError, StepResults
+from homing_gym.vector.worlds import WorldBuilder, start_builder, stop_builder
 
 #: Seconds a closing worker may take before it is killed.
 CLOSE_TIMEOUT = 10.0
@@ -55,8 +56,12 @@ def _serve(conn, makers: list[Callable[[], HomingEnv]], first: int, threads: int
     except Exception as err:      # e.g. envs that cannot be batched: said in the main process
         conn.send(("error", (type(err).__name__, str(err))))
         return
-    conn.send(("ready", (batch.observation_space, batch.action_space)))
-    blocks, views = _attached(conn.recv(), batch.observation_space, batch.num_envs)
+    conn.send(("ready", (batch.observation_space, batch.action_space,
+                         bool(batch.prebuildable))))
+    names, builder = conn.recv()
+    if builder is not None:
+        batch.use_builder(WorldBuilder(builder))
+    blocks, views = _attached(names, batch.observation_space, batch.num_envs)
 
     def write() -> None:
         for key, view in views.items():
@@ -74,6 +79,8 @@ def _serve(conn, makers: list[Callable[[], HomingEnv]], first: int, threads: int
                     answer = (r.rewards, r.terminated, r.truncated, r.infos)
                 elif command in ("call", "set_attr"):
                     answer = getattr(batch, command)(*data)
+                elif command == "served":
+                    answer = batch.worlds_served
                 else:
                     break
             except EnvFailedError as err:
@@ -96,17 +103,22 @@ def _serve(conn, makers: list[Callable[[], HomingEnv]], first: int, threads: int
 
 class ProcessBatch:
     """The envs made by ``makers`` in ``processes`` spawned workers (contiguous shares),
-    each rendering with ``threads`` threads; as :class:`EnvBatch` otherwise."""
+    each rendering with ``threads`` threads; as :class:`EnvBatch` otherwise. With
+    ``prebuild_worlds`` each worker whose envs draw procedural worlds gets a builder
+    process of its own (:mod:`homing_gym.vector.worlds`), started here (a worker is a
+    daemon and may not start one) and stopped with the batch."""
 
     def __init__(self, makers: Sequence[Callable[[], HomingEnv]], processes: int, *,
                  threads: int = 1, max_episode_steps: int | None = None,
-                 mode: AutoresetMode = AutoresetMode.NEXT_STEP):
+                 mode: AutoresetMode = AutoresetMode.NEXT_STEP, prebuild_worlds: bool = False):
         self.num_envs = len(makers)
         bounds = np.linspace(0, self.num_envs, processes + 1).round().astype(int)
         #: ``(first, stop)`` env indices of each worker's share.
         self.shares = [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
         ctx = mp.get_context("spawn")
         self._conns, self._processes, self._blocks = [], [], []
+        #: The world builder processes started for workers (``prebuild_worlds``).
+        self.builders: list[mp.Process] = []
         self._views: list[dict[str, np.ndarray]] = []
         self.closed = False
         self.started = False
@@ -120,7 +132,8 @@ class ProcessBatch:
                 child.close()
                 self._conns.append(parent)
                 self._processes.append(process)
-            spaces_of = self._answers(range(len(self.shares)))
+            ready = self._answers(range(len(self.shares)))
+            spaces_of = [answer[:2] for answer in ready]
             self.observation_space, self.action_space = spaces_of[0]
             for w, (obs_space, act_space) in enumerate(spaces_of[1:], 1):
                 if (obs_space, act_space) != spaces_of[0]:
@@ -135,8 +148,14 @@ class ProcessBatch:
                         create=True, size=max(1, int(np.prod(shape)) * space.dtype.itemsize))
                     self._blocks.append(block)
                     views[key] = np.ndarray(shape, space.dtype, buffer=block.buf)
-                conn.send({key: block.name for key, block in
-                           zip(views, self._blocks[-len(views):])})
+                builder = None
+                if prebuild_worlds and ready[len(self._views)][2]:
+                    process, builder = start_builder(f"homing-worlds-{first}")
+                    self.builders.append(process)
+                conn.send(({key: block.name for key, block in
+                            zip(views, self._blocks[-len(views):])}, builder))
+                if builder is not None:
+                    builder.close()          # the worker holds it now
                 self._views.append(views)
         except BaseException:
             self.close()
@@ -199,6 +218,13 @@ class ProcessBatch:
         return StepResults(np.concatenate(rewards), np.concatenate(terminated),
                            np.concatenate(truncated), [i for part in infos for i in part])
 
+    @property
+    def worlds_served(self) -> int:
+        """New worlds the envs took from the workers' builders so far."""
+        for w in range(len(self.shares)):
+            self._send(w, ("served", None))
+        return sum(self._answers(range(len(self.shares))))
+
     def _per_worker(self, command: str, data_of: Callable[[list[int], list[int]], tuple],
                     indices: Sequence[int] | None) -> list[Any]:
         """Send ``command`` with ``data_of(local indices, positions)`` to each worker
@@ -243,6 +269,8 @@ class ProcessBatch:
             if process.is_alive():
                 process.kill()
                 process.join()
+        for process in self.builders:      # told to stop by their workers, or orphaned
+            stop_builder(process)
         for conn in self._conns:
             conn.close()
         self._views = []

@@ -8,7 +8,11 @@ one is known as soon as the last is taken: a :class:`WorldBuilder` process draws
 builds its ray caster (two thirds of the cost) while the envs step, and the env only
 makes the PyBullet bodies when it resets. The worlds are those the env would build
 itself, pixel for pixel. If the builder is gone (or the env's scene is not a registered
-name that the builder process can look up), the env builds its worlds itself.
+name that the builder process can look up), the env builds its worlds itself. In one
+process the batch starts its builder itself; a worker process of
+:class:`~homing_gym.vector.processes.ProcessBatch` (a daemon, which may not start
+processes of its own) is handed one that the main process started
+(:func:`start_builder`).
 """
 
 from __future__ import annotations
@@ -16,6 +20,7 @@ from __future__ import annotations
 import multiprocessing as mp
 import signal
 import threading
+from multiprocessing.connection import Connection
 
 import numpy as np
 
@@ -55,18 +60,37 @@ def _serve(conn) -> None:
         pass
 
 
-class WorldBuilder:
-    """One spawned process that builds the worlds of a batch's envs ahead of need; a
-    thread of this process receives them as they are done (so that the builder never
-    waits for the pipe)."""
+def start_builder(name: str = "homing-worlds") -> tuple[mp.Process, Connection]:
+    """A spawned builder process (a daemon) and the end of its pipe that a
+    :class:`WorldBuilder` talks through (in this process or handed to another)."""
+    ctx = mp.get_context("spawn")
+    conn, child = ctx.Pipe()
+    process = ctx.Process(target=_serve, args=(child,), daemon=True, name=name)
+    process.start()
+    child.close()
+    return process, conn
 
-    def __init__(self):
-        ctx = mp.get_context("spawn")
-        self._conn, child = ctx.Pipe()
-        self._process = ctx.Process(target=_serve, args=(child,), daemon=True,
-                                    name="homing-worlds")
-        self._process.start()
-        child.close()
+
+def stop_builder(process: mp.Process) -> None:
+    """Wait for a builder process told to close (or whose pipe closed), killing it after
+    :data:`CLOSE_TIMEOUT` seconds."""
+    process.join(CLOSE_TIMEOUT)
+    if process.is_alive():
+        process.kill()
+        process.join()
+
+
+class WorldBuilder:
+    """A builder process that builds the worlds of a batch's envs ahead of need, through
+    ``conn`` (its pipe's end, :func:`start_builder`; by default one started here, which
+    :meth:`close` also stops); a thread of this process receives the worlds as they are
+    done (so that the builder never waits for the pipe)."""
+
+    def __init__(self, conn: Connection | None = None):
+        self._process: mp.Process | None = None
+        if conn is None:
+            self._process, conn = start_builder()
+        self._conn = conn
         self._done: dict[tuple, tuple[Scene, RayCaster] | None] = {}
         self._asked: set[tuple] = set()
         self._dropped: set[tuple] = set()
@@ -128,16 +152,14 @@ class WorldBuilder:
         return world
 
     def close(self) -> None:
-        """Stop the process, then the receiver (the pipe's end tells it); safe to call
-        more than once."""
+        """Tell the process to stop (and wait for it, if started here), then the receiver
+        (the pipe's end tells it); safe to call more than once."""
         try:
             self._conn.send(None)
         except OSError:
             pass
-        self._process.join(CLOSE_TIMEOUT)
-        if self._process.is_alive():
-            self._process.kill()
-            self._process.join()
+        if self._process is not None:
+            stop_builder(self._process)
         self._receiver.join(CLOSE_TIMEOUT)
         self._conn.close()
         self._done.clear()

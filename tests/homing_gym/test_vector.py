@@ -230,17 +230,20 @@ def test_close_frees_every_env_and_thread():
     assert not any(env.sim.connected for env in inner) and not _render_threads()
 
 
-def test_new_worlds_built_ahead_are_those_the_env_builds_itself():
+@pytest.mark.parametrize("processes", [1, 2])
+def test_new_worlds_built_ahead_are_those_the_env_builds_itself(processes):
     """With a new world every episode and stops every step, the envs' worlds come from
-    the builder process (all but the seeded first ones) and equal those single envs
-    build themselves: the same observations step by step."""
-    native = _native(n=2, **SHORT)
+    the builder process (one per worker process; all but the seeded first ones) and
+    equal those single envs build themselves: the same observations step by step."""
+    native = _native(n=2, processes=processes, **SHORT)
     single = [gym.make("homing_gym/LocalHoming-v0", **SHORT) for _ in range(2)]
     try:
         obs, _ = native.reset(seed=3)
         for i, env in enumerate(single):
             env.reset(seed=3 + i)
-        builder = native.unwrapped.batch._builder
+        batch = native.unwrapped.batch
+        if processes == 2:
+            assert len(batch.builders) == 2          # one per worker
         for _ in range(6):                    # stop, then the next step resets: new worlds
             obs = native.step(np.full(2, 3))[0]
             for i, env in enumerate(single):
@@ -249,11 +252,34 @@ def test_new_worlds_built_ahead_are_those_the_env_builds_itself():
             obs = native.step(np.full(2, 3))[0]
             for i, env in enumerate(single):
                 _assert_same_obs({k: v[i] for k, v in obs.items()}, env.reset()[0])
-        assert builder.served >= 10
+        assert batch.worlds_served >= 10
     finally:
         native.close()
         for env in single:
             env.close()
+
+
+def test_a_killed_worker_leaves_no_world_builder():
+    """A worker's builder process ends with the batch, also after the worker was killed;
+    a static world gets no builder."""
+    import multiprocessing as mp
+    import os
+    import signal
+
+    envs = _native(n=2, processes=2, **SHORT)
+    envs.reset(seed=0)
+    batch = envs.unwrapped.batch
+    assert len(batch.builders) == 2 and all(p.is_alive() for p in batch.builders)
+    os.kill(batch._processes[0].pid, signal.SIGKILL)
+    batch._processes[0].join()
+    with pytest.raises(EnvFailedError, match="env 0 failed: its worker process"):
+        envs.step(np.full(2, 3))
+    assert not mp.active_children()
+    static = _native(n=2, processes=2, **SMALL)
+    try:
+        assert static.unwrapped.batch.builders == []
+    finally:
+        static.close()
 
 
 def test_the_vector_benchmark_times_steps_resets_and_the_physics_share(capsys):
@@ -266,10 +292,11 @@ def test_the_vector_benchmark_times_steps_resets_and_the_physics_share(capsys):
           "--episode-steps", "3", "--shapes", "48x256", "--worlds", "random_arena"])
     from homing_gym.vector import benchmark
 
-    results = benchmark.run({"random_arena": {"scene": "random_arena"}}, 2, [1], 20,
+    results = benchmark.run({"random_arena": {"scene": "random_arena"}}, 2, [1, 2], 20,
                             rounds=2, episode_steps=3, shape=(16, 64))
-    single, native = results
+    single, native, workers = results
     assert native.step_p50 <= native.step_p99 and 0 < native.reset_share < 1
+    assert workers.step_p50 <= workers.step_p99 and workers.reset_share is None
     assert 0 < single.physics_s and single.physics_s + single.render_s < 1 / single.steps_per_s
     out = capsys.readouterr().out
     assert "| random_arena | native, 2 envs in 2 processes |" in out and "% physics" in out
