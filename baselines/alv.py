@@ -202,7 +202,6 @@ class ALVController(Controller):
         return ("panorama", "goal", "odometry")
 
     def on_reset(self) -> None:
-        self._goal: np.ndarray | None = None
         self._offset: float | None = None
         self._best_ratio = math.inf
         self._steps = 0
@@ -212,8 +211,7 @@ class ALVController(Controller):
 
     def decide(self, observation) -> Move | None:
         goal = observation["goal"]
-        if self._goal is None or not np.array_equal(goal, self._goal):
-            self._goal = np.array(goal, copy=True)        # a new target: store its ALV
+        if self.is_new_goal(goal):              # a new target: store its ALV
             self._goal_grey = grey_panorama(goal, self.compass_levels)
             self._home_alv = average_landmark_vector(
                 segment_landmarks(goal, self.config).bearings)

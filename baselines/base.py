@@ -82,6 +82,7 @@ class Controller(ABC):
         self.last_direction: float | None = None
         self.last_home_direction: float | None = None
         self.last_move: Move | None = None
+        self._goal: np.ndarray | None = None
 
     def _check_parameter_kinds(self) -> None:
         """``ValueError`` for a parameter not of its default's kind: ``True``/``False``
@@ -153,7 +154,17 @@ class Controller(ABC):
         self.last_direction = None
         self.last_home_direction = None
         self.last_move = None
+        self._goal = None
         self.on_reset()
+
+    def is_new_goal(self, goal: np.ndarray) -> bool:
+        """Whether the goal image ``goal`` differs from the one of the last call (an
+        episode's first, or a route's next target: RouteFollowing-v0 advances it); it is
+        kept (a copy) for the next call."""
+        if self._goal is not None and np.array_equal(goal, self._goal):
+            return False
+        self._goal = np.array(goal, copy=True)
+        return True
 
     def predict(self, observation: dict[str, np.ndarray], state: Any = None,
                 episode_start: Any = None, deterministic: bool = True) -> tuple[Any, Any]:

@@ -170,7 +170,6 @@ class DIDController(Controller):
         require_number("did: max_cycles", self.max_cycles, 1, 10_000, integer=True)
 
     def on_reset(self) -> None:
-        self._goal: np.ndarray | None = None
         self._goal_grey: np.ndarray | None = None
         self._new_target()
 
@@ -196,8 +195,7 @@ class DIDController(Controller):
 
     def decide(self, observation) -> Move | None:
         goal = observation["goal"]
-        if self._goal is None or not np.array_equal(goal, self._goal):
-            self._goal = np.array(goal, copy=True)        # a new target (a route's next)
+        if self.is_new_goal(goal):              # a new target (a route's next)
             self._goal_grey = grey_panorama(goal, self.levels)
             self._new_target()
         if self._stopped:

@@ -197,7 +197,6 @@ class FamiliarityController(Controller):
     def on_reset(self) -> None:
         self._views: np.ndarray | None = None
         self.memory = None
-        self._goal: np.ndarray | None = None
         self.last_scan: np.ndarray | None = None
         self.last_goal_difference: float | None = None
         self._new_target()
@@ -225,8 +224,7 @@ class FamiliarityController(Controller):
                              f"(RouteFollowing-v0 with obs_keys including it)")
         self.learn_route(np.asarray(observation[ROUTE_VIEWS_KEY]))
         goal = observation["goal"]
-        if self._goal is None or not np.array_equal(goal, self._goal):
-            self._goal = np.array(goal, copy=True)        # the route's next target
+        if self.is_new_goal(goal):              # the route's next target
             self._new_target()
             self._goal_grey = grey_panorama(goal, self.levels)
         if self._stopped:

@@ -350,15 +350,13 @@ class MinWarpingController(Controller):
         return replace(self.config, n_columns=max(8, min(DEFAULT_COLUMNS, width - width % 2)))
 
     def on_reset(self) -> None:
-        self._goal: np.ndarray | None = None
         self._steps = 0
         self._stopped = False
         self.last_result: MinWarpResult | None = None
 
     def decide(self, observation) -> Move | None:
         goal = observation["goal"]
-        if self._goal is None or not np.array_equal(goal, self._goal):
-            self._goal = np.array(goal, copy=True)        # a new target: a new snapshot
+        if self.is_new_goal(goal):              # a new target: a new snapshot
             self.config = self._config_for(goal.shape[1])
             self._snapshot = column_image(goal, self.config)
             self._steps, self._stopped = 0, False

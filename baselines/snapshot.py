@@ -454,7 +454,6 @@ class SnapshotController(Controller):
         self.fixed_config = HongConfig(k_psi=self.k_psi_fixed, **common)
 
     def on_reset(self) -> None:
-        self._goal: np.ndarray | None = None
         self._steps = 0
         self._previous: float | None = None
         self._psi: float | None = None
@@ -477,8 +476,7 @@ class SnapshotController(Controller):
                              f"{now_key!r} and {goal_key!r}; got {sorted(observation)} "
                              f"(pass obs_keys to gym.make)")
         goal = observation[goal_key]
-        if self._goal is None or not np.array_equal(goal, self._goal):
-            self._goal = np.array(goal, copy=True)   # a new target: restart the schedule
+        if self.is_new_goal(goal):              # a new target: restart the schedule
             self._steps, self._previous, self._psi, self._stopped = 0, None, None, False
         if self._stopped:
             return None

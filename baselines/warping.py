@@ -201,15 +201,12 @@ class WarpingController(Controller):
             rho_values=tuple(float(v) for v in np.linspace(0, self.rho_max, self.n_rho)))
 
     def on_reset(self) -> None:
-        self._goal: np.ndarray | None = None
         self._goal_image: np.ndarray | None = None
         self.last_result: WarpResult | None = None
 
     def decide(self, observation) -> Move | None:
         goal = observation["goal"]
-        if self._goal is None or not np.array_equal(goal, self._goal):
-            # a new target (RouteFollowing-v0 advances the goal image): new snapshot
-            self._goal = np.array(goal, copy=True)
+        if self.is_new_goal(goal):              # a new target: a new snapshot
             self._goal_image = horizon_image(goal, self.config)
         result = warp_search(horizon_image(observation["panorama"], self.config),
                              self._goal_image, self.config)
