@@ -140,7 +140,7 @@ class ProcessBatch:
                     raise ValueError(f"env {self.shares[w][0]} cannot be batched with env 0: "
                                      f"its spaces {obs_space}, {act_space} differ from "
                                      f"{spaces_of[0]}")
-            for conn, (first, stop) in zip(self._conns, self.shares):
+            for w, (conn, (first, stop)) in enumerate(zip(self._conns, self.shares)):
                 views = {}
                 for key, space in self.observation_space.spaces.items():
                     shape = (stop - first, *space.shape)
@@ -149,7 +149,7 @@ class ProcessBatch:
                     self._blocks.append(block)
                     views[key] = np.ndarray(shape, space.dtype, buffer=block.buf)
                 builder = None
-                if prebuild_worlds and ready[len(self._views)][2]:
+                if prebuild_worlds and ready[w][2]:      # the worker's envs draw worlds
                     process, builder = start_builder(f"homing-worlds-{first}")
                     self.builders.append(process)
                 conn.send(({key: block.name for key, block in
