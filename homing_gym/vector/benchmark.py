@@ -9,8 +9,8 @@ episode) with probability ``1 / episode_steps`` per step, so episodes last about
 ``episode_steps`` steps, at different times in different envs, as a trained policy's do.
 Procedural worlds are measured with a new world every episode (``episodes_per_world=1``).
 
-For the vector env in one process the table also gives the median and 99th-percentile
-time of one vector step and the share of the vector steps' time spent resetting envs
+For each vector env the table also gives the median and 99th-percentile time of one
+vector step, and in one process the share of the vector steps' time spent resetting envs
 (new worlds built, goal snapshots taken): what a step waits for.
 """
 
