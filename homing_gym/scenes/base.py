@@ -14,6 +14,7 @@ from functools import wraps
 from weakref import WeakKeyDictionary
 
 import numpy as np
+from numba import njit
 
 from homing_gym.scenes.appearance import PLAIN, Appearance
 from homing_gym.scenes.footprint import ClearanceField, clearance_field
@@ -269,6 +270,32 @@ def _mesh_field(scene: Scene) -> ClearanceField | None:
     return clearance_field(scene.meshes, scene.bounds, scene.height_band)
 
 
+@njit(cache=True, error_model="numpy")
+def _obstacle_clearances(pts, starts, dirs, half_thickness, centres, cos_sin, half_extent,
+                         radius, free):  # pragma: no cover (numba)
+    """Lower ``free[i]`` to point ``pts[i]``'s distance (metres) to the nearest wall (its
+    centre line ``starts + t dirs``, t in [0, 1], less half its thickness) and landmark
+    footprint (a box's rotated rectangle widened by ``radius``: a cylinder is a point
+    widened by its radius; 0 inside), in place. The same floating-point operations as the
+    arrays of earlier versions, one point at a time (19,000 grid points of a room world
+    in about a millisecond, against 19 ms)."""
+    for i in range(pts.shape[0]):
+        px, py = pts[i, 0], pts[i, 1]
+        best = free[i]
+        for w in range(starts.shape[0]):
+            rx, ry = px - starts[w, 0], py - starts[w, 1]
+            dx, dy = dirs[w, 0], dirs[w, 1]
+            t = min(max((rx * dx + ry * dy) / (dx * dx + dy * dy), 0.0), 1.0)
+            best = min(best, math.hypot(rx - t * dx, ry - t * dy) - half_thickness[w])
+        for k in range(centres.shape[0]):
+            ex, ey = px - centres[k, 0], py - centres[k, 1]
+            c, s = cos_sin[k, 0], cos_sin[k, 1]
+            lx = max(abs(c * ex + s * ey) - half_extent[k, 0], 0.0)
+            ly = max(abs(-s * ex + c * ey) - half_extent[k, 1], 0.0)
+            best = min(best, max(math.hypot(lx, ly) - radius[k], 0.0))
+        free[i] = best
+
+
 def clearances(scene: Scene, points) -> np.ndarray:
     """:func:`clearance` of many floor points ``(N, 2)`` (metres) at once: the distance
     to each wall's centre line less half its thickness, to each landmark's footprint
@@ -279,19 +306,9 @@ def clearances(scene: Scene, points) -> np.ndarray:
     free = np.minimum(np.minimum(pts[:, 0] - xmin, xmax - pts[:, 0]),
                       np.minimum(pts[:, 1] - ymin, ymax - pts[:, 1]))
     ob = _obstacles(scene)
-    if len(ob.starts):
-        rel = pts[:, None, :] - ob.starts[None]                       # (N, W, 2)
-        t = np.clip(np.einsum("nwk,wk->nw", rel, ob.dirs)
-                    / np.einsum("wk,wk->w", ob.dirs, ob.dirs), 0.0, 1.0)
-        gap = rel - t[..., None] * ob.dirs[None]
-        free = np.minimum(free, np.min(np.hypot(gap[..., 0], gap[..., 1])
-                                       - ob.half_thickness, axis=1))
-    if len(ob.centres):
-        d = pts[:, None, :] - ob.centres[None]                        # (N, L, 2)
-        c, s = ob.cos_sin[:, 0], ob.cos_sin[:, 1]
-        lx = np.maximum(np.abs(c * d[..., 0] + s * d[..., 1]) - ob.half_extent[:, 0], 0.0)
-        ly = np.maximum(np.abs(-s * d[..., 0] + c * d[..., 1]) - ob.half_extent[:, 1], 0.0)
-        free = np.minimum(free, np.min(np.maximum(np.hypot(lx, ly) - ob.radius, 0.0), axis=1))
+    if len(ob.starts) or len(ob.centres):
+        _obstacle_clearances(pts, ob.starts, ob.dirs, ob.half_thickness, ob.centres,
+                             ob.cos_sin, ob.half_extent, ob.radius, free)
     field = _mesh_field(scene) if scene.meshes else None
     if field is not None:
         free = np.minimum(free, field(pts))

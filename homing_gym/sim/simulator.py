@@ -100,6 +100,8 @@ class Simulator:
         c.setPhysicsEngineParameter(deterministicOverlappingPairs=1, numSolverIterations=10)
         if self._gui:
             c.configureDebugVisualizer(p.COV_ENABLE_GUI, 0)
+        if not self._drawn:     # no visual shapes made for its TinyRenderer: half a URDF's cost
+            c.configureDebugVisualizer(p.COV_ENABLE_TINY_RENDERER, 0)
         self._textures: dict[str, int] = {}
         self.scene = scene
         self.floor_id = self._make_floor(scene)
