@@ -186,11 +186,10 @@ class EnvBatch:
         infos: list[dict[str, Any]] = [{}] * n
         moved: dict[int, tuple[float, bool, dict[str, Any], bool]] = {}
         pending: dict[int, Future] = {}
+        resets = (np.flatnonzero(self._autoreset).tolist()
+                  if self.mode is AutoresetMode.NEXT_STEP else [])
         try:
-            for i in range(n):
-                if self.mode is AutoresetMode.NEXT_STEP and self._autoreset[i]:
-                    infos[i] = self._reset(i)
-                    continue
+            for i in sorted(set(range(n)) - set(resets)):
                 env = self.envs[i]
                 try:
                     moved[i] = env.advance(actions[i])
@@ -201,11 +200,14 @@ class EnvBatch:
                          if not skip and self.envs[i].reads_panorama]
                 pending = {k: self._pool.submit(_render_all, drawn[k::self._threads])
                            for k in range(min(self._threads, len(drawn)))}
-                for k in list(pending):
-                    failed = pending.pop(k).result()
-                    if failed is not None:
-                        index, error = failed
-                        raise self._failed(index, error) from error
+            # the envs whose episodes ended reset while the others' panoramas render
+            for i in resets:
+                infos[i] = self._reset(i)
+            for k in list(pending):
+                failed = pending.pop(k).result()
+                if failed is not None:
+                    index, error = failed
+                    raise self._failed(index, error) from error
             for i, (reward, term, info, skip) in moved.items():
                 try:
                     self.obs[i] = self.envs[i].observation(skip)
