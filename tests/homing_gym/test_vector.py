@@ -196,6 +196,24 @@ def test_a_failing_env_is_named_once_and_every_env_is_closed():
     envs.close()
 
 
+def test_an_env_failing_to_reset_while_the_others_render_is_named_once():
+    envs = _native(n=3, threads=2, **SMALL)
+    envs.reset(seed=0)
+    batch = envs.unwrapped.batch
+
+    def broken(**kwargs):
+        raise RuntimeError("no world")
+
+    batch.envs[1].reset = broken
+    batch._autoreset[1] = True          # env 1's episode ended: it resets at this step
+    with pytest.raises(EnvFailedError, match="env 1 failed: RuntimeError") as err:
+        envs.step(np.full((3, 2), 0.5, np.float32))
+    assert err.value.index == 1
+    assert not any(env.sim.connected for env in batch.envs)
+    assert not _render_threads()
+    envs.close()
+
+
 def test_a_failing_or_killed_worker_is_named_and_no_process_is_left():
     import multiprocessing as mp
     import os
