@@ -277,8 +277,8 @@ def _obstacle_clearances(pts, starts, dirs, half_thickness, centres, cos_sin, ha
     centre line ``starts + t dirs``, t in [0, 1], less half its thickness) and landmark
     footprint (a box's rotated rectangle widened by ``radius``: a cylinder is a point
     widened by its radius; 0 inside), in place. The same floating-point operations as the
-    arrays of earlier versions, one point at a time (19,000 grid points of a room world
-    in about a millisecond, against 19 ms)."""
+    arrays of earlier versions, one point at a time (the 19,000-point free-space grid of a
+    room world in 5 ms, against 19)."""
     for i in range(pts.shape[0]):
         px, py = pts[i, 0], pts[i, 1]
         best = free[i]

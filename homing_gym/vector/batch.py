@@ -186,10 +186,10 @@ class EnvBatch:
         infos: list[dict[str, Any]] = [{}] * n
         moved: dict[int, tuple[float, bool, dict[str, Any], bool]] = {}
         pending: dict[int, Future] = {}
-        resets = (np.flatnonzero(self._autoreset).tolist()
-                  if self.mode is AutoresetMode.NEXT_STEP else [])
+        ended = (self._autoreset.copy() if self.mode is AutoresetMode.NEXT_STEP
+                 else np.zeros(n, np.bool_))           # reset at this step, not stepped
         try:
-            for i in sorted(set(range(n)) - set(resets)):
+            for i in np.flatnonzero(~ended).tolist():
                 env = self.envs[i]
                 try:
                     moved[i] = env.advance(actions[i])
@@ -201,7 +201,7 @@ class EnvBatch:
                 pending = {k: self._pool.submit(_render_all, drawn[k::self._threads])
                            for k in range(min(self._threads, len(drawn)))}
             # the envs whose episodes ended reset while the others' panoramas render
-            for i in resets:
+            for i in np.flatnonzero(ended).tolist():
                 infos[i] = self._reset(i)
             for k in list(pending):
                 failed = pending.pop(k).result()
