@@ -90,7 +90,8 @@ def test_rendered_view_turned_away_is_turned_back(name, make_env, controller_for
     controller = controller_for(name, env)
     controller.reset(0)
     controller.learn_route(obs["route_views"])
-    now = grey_panorama(u.render_panorama((x0, y0, yaw + math.radians(25))), 2)
+    now = grey_panorama(u.render_panorama((x0, y0, yaw + math.radians(25))),
+                       controller.levels)
     shifts = scan_shifts(now.shape[1], 180.0)
     turn = shift_angle(best_shift(shifts, controller.memory.unfamiliarity(
         scan_views(now, shifts))), now.shape[1])
