@@ -84,11 +84,11 @@ nothing); and after ``max_target_steps`` decisions for one target (a safety limi
 --protocol routes --seed 100000``: none of the canonical draw's episodes): at 0.6 the
 difference to a target 0.3 m ahead among trees and rocks often never fell below 0.6
 ``d_0``, the robot drove past it without stopping, and the goal was then a target left
-behind (with 2 pyramid reductions, Perfect Memory's last stop within the radius on 2 of 10 natural routes; 8 of 10
-at 0.8 and at 0.9, which stopped short of more targets on the way: every target in 5 and
-1 of 10; Infomax 2 of 10 -> 6 of 10 at 0.8). With 1 reduction (the default) 0.7, 0.8 and 0.9 did
-alike on 30 validation natural routes (Perfect Memory 28, 28 and 29 of 30), so 0.8
-stayed.
+behind (with 2 pyramid reductions, Perfect Memory's last stop within the radius on 2 of
+10 natural routes; 8 of 10 at 0.8 and at 0.9, which stopped short of more targets on
+the way: every target in 5 and 1 of 10; Infomax 2 of 10 -> 6 of 10 at 0.8). With 1
+reduction (the default) 0.7, 0.8 and 0.9 did alike on 30 validation natural routes
+(Perfect Memory 28, 28 and 29 of 30), so 0.8 stayed.
 A stop leaves the target (the env's rule, whatever the distance); the scan then
 continues along the route towards the next target. The stop reads only the ``goal``
 observation, which every method of the route protocol gets. Why not a stop from the
