@@ -11,11 +11,16 @@ Procedural worlds are measured with a new world every episode (``episodes_per_wo
 
 For each vector env the table also gives the median and 99th-percentile time of one
 vector step, and in one process the share of the vector steps' time spent resetting envs
-(new worlds built, goal snapshots taken): what a step waits for.
+(new worlds built, goal snapshots taken): what a step waits for. For each number of
+worker processes ``K`` > 1 it also runs ``K`` independent processes of one env each at
+once (``independent xK``, after the rounds): the env steps per second the cores give
+without any batching, the ceiling of a vector env on this machine.
 """
 
 from __future__ import annotations
 
+import multiprocessing as mp
+import queue
 import time
 from dataclasses import dataclass
 
@@ -70,6 +75,61 @@ def _actions(space: spaces.Space, n: int, p_stop: float, rng: np.random.Generato
     return actions
 
 
+def _stepped(env: gym.Env, actions: np.ndarray) -> float:
+    """Env steps per second of ``env`` taking ``actions`` (reset when an episode ends)."""
+    start = time.perf_counter()
+    for a in actions:
+        _, _, terminated, truncated, _ = env.step(a)
+        if terminated or truncated:
+            env.reset()
+    return len(actions) / (time.perf_counter() - start)
+
+
+def _independent(env_id: str, settings: dict, steps: int, p_stop: float, seed: int,
+                 barrier, rates) -> None:
+    """One of the independent processes: make and reset its env, wait for the others,
+    then step; its env steps per second go to ``rates``."""
+    env = gym.make(env_id, **settings)
+    try:
+        env.reset(seed=seed)
+        env.action_space.seed(seed)
+        actions = _actions(env.action_space, steps, p_stop, np.random.default_rng(seed))
+        barrier.wait(timeout=300.0)     # a sibling that failed breaks it: no hang
+        rates.put(_stepped(env, actions))
+    finally:
+        env.close()
+
+
+def independent_rate(env_id: str, settings: dict, processes: int, steps: int,
+                     p_stop: float) -> float:
+    """Env steps per second of ``processes`` spawned processes of one env each, started
+    together, ``steps`` steps each (the sum of their rates); ``RuntimeError`` naming a
+    process that died."""
+    ctx = mp.get_context("spawn")
+    barrier, rates = ctx.Barrier(processes), ctx.Queue()
+    workers = [ctx.Process(target=_independent, daemon=True, name=f"homing-bench-{k}",
+                           args=(env_id, settings, steps, p_stop, k, barrier, rates))
+               for k in range(processes)]
+    try:
+        for w in workers:
+            w.start()
+        got: list[float] = []
+        while len(got) < processes:
+            try:
+                got.append(rates.get(timeout=1.0))
+            except queue.Empty:
+                dead = [w for w in workers if w.exitcode not in (None, 0)]
+                if dead:
+                    raise RuntimeError(f"benchmark process {dead[0].name} died with exit "
+                                       f"code {dead[0].exitcode}") from None
+        return float(sum(got))
+    finally:
+        for w in workers:
+            w.join(5.0)
+            if w.is_alive():
+                w.kill()
+
+
 def world_settings(world: str, world_kwargs: dict) -> dict:
     """Env kwargs of ``world`` (:func:`homing_gym.benchmark.world_kwargs`); a procedural
     scene draws a new world every episode."""
@@ -104,12 +164,8 @@ def run(worlds: dict[str, dict], num_envs: int, processes: list[int], steps: int
                 v.reset(seed=0)
             single.action_space.seed(0)
             for _ in tqdm(range(rounds), desc=f"{world}: single env and vector envs in turn"):
-                start = time.perf_counter()
-                for a in _actions(single.action_space, steps, p_stop, rng):
-                    _, _, terminated, truncated, _ = single.step(a)
-                    if terminated or truncated:
-                        single.reset()
-                rates["single"].append(steps / (time.perf_counter() - start))
+                rates["single"].append(_stepped(single, _actions(single.action_space, steps,
+                                                                  p_stop, rng)))
                 single_steps += steps
                 for p, v in vectors.items():
                     batch = v.unwrapped.batch
@@ -128,6 +184,8 @@ def run(worlds: dict[str, dict], num_envs: int, processes: list[int], steps: int
             single.close()
             for v in vectors.values():
                 v.close()
+        independent = {p: independent_rate(env_id, settings, p, steps * rounds // 2, p_stop)
+                       for p in processes if p > 1}
         results.append(VectorResult(world, "single", float(np.median(rates.pop("single"))),
                                     physics_s=physics.seconds / single_steps,
                                     render_s=render.seconds / single_steps))
@@ -137,6 +195,8 @@ def run(worlds: dict[str, dict], num_envs: int, processes: list[int], steps: int
                 world, f"native x{p}", float(np.median(rates[f"native x{p}"])),
                 float(np.median(step_times)), float(np.percentile(step_times, 99)),
                 resets[0] / resets[1] if p == 1 else None))
+        results += [VectorResult(world, f"independent x{p}", rate)
+                    for p, rate in independent.items()]
     return results
 
 
@@ -151,9 +211,12 @@ def table(results: list[VectorResult], num_envs: int) -> str:
              f"{1e3 / r.steps_per_s:.3f} ms ({100 * r.physics_s * r.steps_per_s:.0f}% "
              f"physics; resets included)" for r in results if r.physics_s is not None]
     for r in results:
-        config = (r.config if r.config == "single" else
-                  f"native, {num_envs} envs in {r.config.split('x')[1]} process"
-                  + ("es" if r.config != "native x1" else ""))
+        count = r.config.split("x")[-1]
+        config = ("single" if r.config == "single" else
+                  f"{count} independent processes of one env each (the cores' ceiling)"
+                  if r.config.startswith("independent") else
+                  f"native, {num_envs} envs in {count} process"
+                  + ("es" if count != "1" else ""))
         share = "-" if r.reset_share is None else f"{100 * r.reset_share:.0f}%"
         timing = ("| - | - | - | - |" if r.step_p50 is None else
                   f"| {1e3 * r.step_p50:.2f} | {1e3 * r.step_p99:.2f} | "
