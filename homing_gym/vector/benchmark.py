@@ -14,7 +14,10 @@ vector step, and in one process the share of the vector steps' time spent resett
 (new worlds built, goal snapshots taken): what a step waits for. For each number of
 worker processes ``K`` > 1 it also runs ``K`` independent processes of one env each at
 once (``independent xK``, after the rounds): the env steps per second the cores give
-without any batching, the ceiling of a vector env on this machine.
+without any batching, the ceiling of a vector env on this machine; and how rendering
+alone scales: each process renders panoramas at its robot's pose by itself (the others
+waiting), then all at once; the sum over the processes of their rate at once over their
+rate alone is ``K`` where the cores do not slow each other down.
 """
 
 from __future__ import annotations
@@ -37,7 +40,8 @@ class VectorResult:
     """One configuration's env steps per second (median over rounds); for vector envs
     also their step times (seconds), in one process the share of them spent in resets;
     for the single env the time (seconds per step) in PyBullet's physics (the sub-steps,
-    motor updates and contact checks) and in rendering."""
+    motor updates and contact checks) and in rendering; for ``independent xK`` how
+    rendering alone scales over the ``K`` processes (``K`` at best)."""
 
     world: str
     config: str
@@ -47,6 +51,7 @@ class VectorResult:
     reset_share: float | None = None
     physics_s: float | None = None
     render_s: float | None = None
+    render_scaling: float | None = None
 
 
 class _Timed:
@@ -85,26 +90,44 @@ def _stepped(env: gym.Env, actions: np.ndarray) -> float:
     return len(actions) / (time.perf_counter() - start)
 
 
+def _rendered(env: gym.Env, count: int) -> float:
+    """Panoramas per second of ``env``'s camera rendering ``count`` at its robot's pose."""
+    u = env.unwrapped
+    start = time.perf_counter()
+    for _ in range(count):
+        u.render_panorama(u.pose)
+    return count / (time.perf_counter() - start)
+
+
 def _independent(env_id: str, settings: dict, steps: int, p_stop: float, seed: int,
                  barrier, rates) -> None:
     """One of the independent processes: make and reset its env, wait for the others,
-    then step; its env steps per second go to ``rates``."""
+    then step; then render ``steps // 4`` panoramas alone (each process in its turn) and
+    at once with the others. Its env steps per second and panoramas per second at once
+    over alone go to ``rates``."""
     env = gym.make(env_id, **settings)
     try:
         env.reset(seed=seed)
         env.action_space.seed(seed)
         actions = _actions(env.action_space, steps, p_stop, np.random.default_rng(seed))
         barrier.wait(timeout=300.0)     # a sibling that failed breaks it: no hang
-        rates.put(_stepped(env, actions))
+        stepped = _stepped(env, actions)
+        count = max(steps // 4, 1)
+        for turn in range(barrier.parties):
+            barrier.wait(timeout=300.0)
+            if turn == seed:
+                alone = _rendered(env, count)
+        barrier.wait(timeout=300.0)
+        rates.put((stepped, _rendered(env, count) / alone))
     finally:
         env.close()
 
 
-def independent_rate(env_id: str, settings: dict, processes: int, steps: int,
-                     p_stop: float) -> float:
+def independent_rates(env_id: str, settings: dict, processes: int, steps: int,
+                      p_stop: float) -> tuple[float, float]:
     """Env steps per second of ``processes`` spawned processes of one env each, started
-    together, ``steps`` steps each (the sum of their rates); ``RuntimeError`` naming a
-    process that died."""
+    together, ``steps`` steps each (the sum of their rates), and how rendering scales
+    over them (:func:`_independent`); ``RuntimeError`` naming a process that died."""
     ctx = mp.get_context("spawn")
     barrier, rates = ctx.Barrier(processes), ctx.Queue()
     workers = [ctx.Process(target=_independent, daemon=True, name=f"homing-bench-{k}",
@@ -113,7 +136,7 @@ def independent_rate(env_id: str, settings: dict, processes: int, steps: int,
     try:
         for w in workers:
             w.start()
-        got: list[float] = []
+        got: list[tuple[float, float]] = []
         while len(got) < processes:
             try:
                 got.append(rates.get(timeout=1.0))
@@ -122,7 +145,7 @@ def independent_rate(env_id: str, settings: dict, processes: int, steps: int,
                 if dead:
                     raise RuntimeError(f"benchmark process {dead[0].name} died with exit "
                                        f"code {dead[0].exitcode}") from None
-        return float(sum(got))
+        return float(sum(g[0] for g in got)), float(sum(g[1] for g in got))
     finally:
         for w in workers:
             w.join(5.0)
@@ -184,7 +207,7 @@ def run(worlds: dict[str, dict], num_envs: int, processes: list[int], steps: int
             single.close()
             for v in vectors.values():
                 v.close()
-        independent = {p: independent_rate(env_id, settings, p, steps * rounds // 2, p_stop)
+        independent = {p: independent_rates(env_id, settings, p, steps * rounds // 2, p_stop)
                        for p in processes if p > 1}
         results.append(VectorResult(world, "single", float(np.median(rates.pop("single"))),
                                     physics_s=physics.seconds / single_steps,
@@ -195,8 +218,8 @@ def run(worlds: dict[str, dict], num_envs: int, processes: list[int], steps: int
                 world, f"native x{p}", float(np.median(rates[f"native x{p}"])),
                 float(np.median(step_times)), float(np.percentile(step_times, 99)),
                 resets[0] / resets[1] if p == 1 else None))
-        results += [VectorResult(world, f"independent x{p}", rate)
-                    for p, rate in independent.items()]
+        results += [VectorResult(world, f"independent x{p}", rate, render_scaling=scaling)
+                    for p, (rate, scaling) in independent.items()]
     return results
 
 
@@ -210,6 +233,9 @@ def table(results: list[VectorResult], num_envs: int) -> str:
              f"{1e3 * r.render_s:.3f} ms of rendering per step, of "
              f"{1e3 / r.steps_per_s:.3f} ms ({100 * r.physics_s * r.steps_per_s:.0f}% "
              f"physics; resets included)" for r in results if r.physics_s is not None]
+    split += [f"* {r.world}, rendering alone in {r.config.split('x')[-1]} independent "
+              f"processes at once: {r.render_scaling:.2f}x one process's rate"
+              for r in results if r.render_scaling is not None]
     for r in results:
         count = r.config.split("x")[-1]
         config = ("single" if r.config == "single" else

@@ -318,16 +318,18 @@ def test_the_vector_benchmark_times_steps_resets_and_the_physics_share(capsys):
     assert 0 < single.physics_s and single.physics_s + single.render_s < 1 / single.steps_per_s
     assert independent.config == "independent x2" and independent.steps_per_s > 0
     assert independent.step_p50 is None
+    assert 0 < independent.render_scaling < 3        # 2 at best, up to noise
     out = capsys.readouterr().out
     assert "| random_arena | native, 2 envs in 2 processes |" in out and "% physics" in out
     assert "| random_arena | 2 independent processes of one env each" in out
+    assert "random_arena, rendering alone in 2 independent processes at once:" in out
 
 
 def test_the_benchmark_names_an_independent_process_that_died():
-    from homing_gym.vector.benchmark import independent_rate
+    from homing_gym.vector.benchmark import independent_rates
 
     with pytest.raises(RuntimeError, match="homing-bench-.* died with exit code 1"):
-        independent_rate("homing_gym/LocalHoming-v0", {"scene": "no_such_scene"}, 2, 5, 0.0)
+        independent_rates("homing_gym/LocalHoming-v0", {"scene": "no_such_scene"}, 2, 5, 0.0)
 
 
 def _assert_same_infos(a, b):
