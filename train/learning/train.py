@@ -142,6 +142,7 @@ class TrainConfig:
     init_policy: str | None = None
     critic_warmup_steps: int = 0
     curriculum: dict | None = None
+    augment: dict | None = None
     ppo: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -188,6 +189,10 @@ class TrainConfig:
         check_device(self.device)
         if self.curriculum is not None:
             CurriculumSettings.from_value(self.curriculum)
+        if self.augment is not None:
+            from homing_train.learning.augment import AugmentSettings
+
+            AugmentSettings.from_value(self.augment)
         scenes = self.env_kwargs.get("scene")
         if isinstance(scenes, list):
             if not scenes or not all(isinstance(name, str) for name in scenes):
@@ -349,14 +354,17 @@ def worker_error(report_dir: Path) -> EnvWorkerError | None:
     return error
 
 
-def make_vec(config: TrainConfig, n_envs: int, seed: int, report_dir: Path | None = None):
+def make_vec(config: TrainConfig, n_envs: int, seed: int, report_dir: Path | None = None,
+             augmented: bool = True):
     """A monitored vector env of ``n_envs`` envs (env ``i``: :meth:`TrainConfig.env_kwargs_of`
     ``(i)``, seed ``seed + i``; success logged from ``is_success``), images transposed to
     channel-first; subprocess workers write their errors to ``report_dir``. With
     ``vec="subproc"``, one process per env, or ``config.workers`` processes each stepping
     a group of envs (:class:`~homing_train.learning.grouped_vec_env.GroupedSubprocVecEnv`);
     with ``vec="native"``, homing-gym's native vector env in this process or
-    ``config.workers`` processes (:mod:`homing_train.learning.native_vec_env`)."""
+    ``config.workers`` processes (:mod:`homing_train.learning.native_vec_env`). With
+    ``config.augment`` and ``augmented`` (the training envs, not the evaluation's), each
+    episode's images in its own colours (:mod:`homing_train.learning.augment`)."""
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv, VecTransposeImage
 
     from homing_train.learning.grouped_vec_env import GroupedSubprocVecEnv
@@ -366,7 +374,7 @@ def make_vec(config: TrainConfig, n_envs: int, seed: int, report_dir: Path | Non
         env = native_vec_env(config.env_id, [config.env_kwargs_of(r) for r in range(n_envs)],
                              processes=config.workers or 1)
         env.seed(seed)
-        return VecTransposeImage(env)
+        return VecTransposeImage(_augmented(env, config, seed, augmented))
     report = None if report_dir is None else str(report_dir)
     fns = [partial(make_monitored_env, config.env_id, config.env_kwargs_of(rank), report)
            for rank in range(n_envs)]
@@ -378,7 +386,17 @@ def make_vec(config: TrainConfig, n_envs: int, seed: int, report_dir: Path | Non
     else:
         env = SubprocVecEnv(fns, start_method="spawn")
     env.seed(seed)
-    return VecTransposeImage(env)      # channel-first images, as SB3 would wrap them itself
+    # channel-first images, as SB3 would wrap them itself
+    return VecTransposeImage(_augmented(env, config, seed, augmented))
+
+
+def _augmented(env, config: TrainConfig, seed: int, augmented: bool):
+    """``env`` with ``config.augment``'s colour transforms where ``augmented``."""
+    if config.augment is None or not augmented:
+        return env
+    from homing_train.learning.augment import AugmentedImages, AugmentSettings
+
+    return AugmentedImages(env, AugmentSettings.from_value(config.augment), seed)
 
 
 def versions() -> dict[str, str]:
@@ -682,7 +700,7 @@ def train(config: TrainConfig, out: Path, resume: bool = False,
     report_dir = Path(tempfile.mkdtemp(prefix="homing-train-workers-"))
     env = make_vec(config, config.n_envs, config.seed + done_steps, report_dir)
     eval_env = make_vec(TrainConfig(**{**asdict(config), "vec": "dummy"}), config.n_scenes,
-                        config.seed + EVAL_SEED_OFFSET)
+                        config.seed + EVAL_SEED_OFFSET, augmented=False)
     try:
         if checkpoint is not None:
             model = PPO.load(checkpoint, env=env, device=config.device,
