@@ -130,13 +130,15 @@ def test_a_recipe_rebuilds_the_config_its_policy_was_trained_with(tmp_path, caps
     package, its record moved to train/learning/recipes/)."""
     shipped = yaml.safe_load(Path("train/shipped/ppo_procedural_long.yml").read_text())
     env_id, settings = recipe("ppo_procedural_long")
-    assert asdict(make_config(env_id, settings)) == shipped["config"]
+    rebuilt = asdict(make_config(env_id, settings))
+    assert rebuilt.pop("augment") is None      # recorded before augmentation existed: off
+    assert rebuilt == shipped["config"]
     assert not Path("train/shipped/ppo_procedural_fast.zip").exists()
     recorded = yaml.safe_load(Path("train/learning/recipes/ppo_procedural_fast.yml").read_text())
     env_id, settings = recipe("ppo_procedural_fast")
     assert env_id == "homing_gym/LocalHoming-v0" and settings["n_steps"] == 64
     config = make_config(env_id, settings)
-    assert asdict(config) == recorded["config"]
+    assert {k: v for k, v in asdict(config).items() if k != "augment"} == recorded["config"]
     reseeded = make_config(env_id, {**settings, **parse_overrides(["n_epochs=3"])}, seed=1)
     assert (reseeded.seed, reseeded.ppo["n_epochs"], reseeded.n_envs) == (1, 3, 64)
     with pytest.raises(ValueError, match="unknown recipe 'ppo_fast'.*ppo_procedural_fast"):
@@ -513,8 +515,8 @@ def test_ctrl_c_saves_the_run_and_resume_continues_with_new_episode_seeds(tmp_pa
     seeds = []
     real_make_vec = train_module.make_vec
     monkeypatch.setattr(train_module, "make_vec",
-                        lambda config, n, seed, *rest: seeds.append(seed)
-                        or real_make_vec(config, n, seed, *rest))
+                        lambda config, n, seed, *rest, **kw: seeds.append(seed)
+                        or real_make_vec(config, n, seed, *rest, **kw))
     assert main(["--resume", str(run), "--timesteps", "256", "--no-progress"]) == 0
     config_seed = yaml.safe_load((run / "config.yml").read_text())["seed"]
     assert seeds[0] == config_seed + 128          # training envs: not the first run's seeds
