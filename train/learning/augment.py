@@ -91,11 +91,17 @@ class AugmentSettings:
 def transformed(images: np.ndarray, matrix: np.ndarray, gamma: float) -> np.ndarray:
     """``images (..., 3)`` uint8 RGB through one colour transform (:meth:`AugmentSettings.
     draw`): uint8 of the same shape."""
-    x = images.astype(np.float32) * np.float32(1 / 255)
-    y = np.clip(x @ matrix.T.astype(np.float32), 0.0, 1.0)
-    if gamma != 1.0:
-        y = y ** np.float32(gamma)
-    return np.rint(y * 255).astype(np.uint8)
+    return batch_transformed(images[None], matrix[None], np.array([gamma]))[0]
+
+
+def batch_transformed(images: np.ndarray, matrices: np.ndarray,
+                      gammas: np.ndarray) -> np.ndarray:
+    """``images (N, ..., 3)`` uint8 RGB, image ``i`` through ``matrices[i]`` and
+    ``gammas[i]`` (:meth:`AugmentSettings.draw`), in one call: uint8 of the same shape."""
+    x = images.reshape(len(images), -1, 3).astype(np.float32) * np.float32(1 / 255)
+    y = np.clip(x @ matrices.transpose(0, 2, 1).astype(np.float32), 0.0, 1.0)
+    y **= gammas.astype(np.float32)[:, None, None]
+    return np.rint(y * 255).astype(np.uint8).reshape(images.shape)
 
 
 class AugmentedImages(VecEnvWrapper):
@@ -115,9 +121,10 @@ class AugmentedImages(VecEnvWrapper):
         self._draws = [settings.draw(self._rng) for _ in range(self.num_envs)]
 
     def _apply(self, obs: dict) -> dict:
+        matrices = np.stack([m for m, _ in self._draws])
+        gammas = np.array([g for _, g in self._draws])
         for key in self.image_keys:
-            obs[key] = np.stack([transformed(obs[key][i], *self._draws[i])
-                                 for i in range(self.num_envs)])
+            obs[key] = batch_transformed(obs[key], matrices, gammas)
         return obs
 
     def reset(self):
