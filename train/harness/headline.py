@@ -16,7 +16,7 @@ from typing import Mapping, Sequence
 
 import homing_baselines
 from homing_train.harness.matrix import Cell, cell_methods
-from homing_train.harness.policies import DEFAULT_POLICY, shipped_policies
+from homing_train.harness.policies import DEFAULT_POLICY, resolved_name, shipped_policies
 from homing_train.harness.protocols import PROTOCOLS, Protocol
 
 #: Episodes per setting of each headline protocol, in the order of the table: the
@@ -84,7 +84,7 @@ def headline_plan(episodes: int | None = None, methods: Sequence[str] | None = N
               for p in protocols}
     cell_episodes = {p.name: sum(len(s.episode_tasks(counts[p.name], p.seed))
                                  for s in p.settings) for p in protocols}
-    chosen = [DEFAULT_POLICY if m == "ppo" else m for m in methods or []]
+    chosen = [resolved_name(m) for m in methods or []]
     return HeadlinePlan(protocols, counts, tuple(chosen or default_methods(protocols)),
                         cell_episodes)
 

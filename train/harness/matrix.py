@@ -48,8 +48,9 @@ import homing_baselines  # noqa: E402
 from homing_gym.cli import command_parser  # noqa: E402
 from homing_train.extras import missing_extra  # noqa: E402
 from homing_train.harness.evaluate import EpisodeRecord, evaluate, summarize  # noqa: E402
-from homing_train.harness.policies import (DEFAULT_POLICY, ShippedPolicy,  # noqa: E402
-                                           recorded_settings, shipped_policies)
+from homing_train.harness.policies import (ShippedPolicy,  # noqa: E402
+                                           recorded_settings, resolved_name,
+                                           shipped_policies)
 from homing_train.harness.metrics import aggregate_success, wilson_interval  # noqa: E402
 from homing_train.harness.protocols import (POLICIES, PROTOCOLS, Protocol,  # noqa: E402
                                             episodes_key)
@@ -191,7 +192,7 @@ def run_cell(protocol: Protocol, method: str, out: Path, episodes: int | None = 
     :func:`~homing_train.harness.policies.recorded_settings` as a shipped one is) on every setting of ``protocol`` (``episodes`` per setting, default
     the protocol's) into ``out`` (``backend``/``address``:
     :func:`homing_train.harness.evaluate.run_episodes`)."""
-    method = DEFAULT_POLICY if method == "ppo" else method
+    method = resolved_name(method)
     n = protocol.episodes if episodes is None else episodes
     if n < 1:
         raise ValueError(f"episodes must be >= 1, got {n}")

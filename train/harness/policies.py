@@ -311,6 +311,11 @@ POLICY_DIR = Path(str(resources.files("homing_train") / "shipped"))
 DEFAULT_POLICY = "ppo_procedural_long"
 
 
+def resolved_name(method: str) -> str:
+    """``method`` with the alias ``"ppo"`` replaced by :data:`DEFAULT_POLICY`."""
+    return DEFAULT_POLICY if method == "ppo" else method
+
+
 def shipped_policy_names() -> list[str]:
     """The names of the shipped policies (their zips in :data:`POLICY_DIR`)."""
     return sorted(p.stem for p in POLICY_DIR.glob("*.zip"))
@@ -319,7 +324,7 @@ def shipped_policy_names() -> list[str]:
 def shipped_policy_path(name: str) -> str | None:
     """The zip of the shipped policy ``name`` (``"ppo"``: :data:`DEFAULT_POLICY`), or
     ``None`` when no shipped policy has that name."""
-    name = DEFAULT_POLICY if name == "ppo" else name
+    name = resolved_name(name)
     return str(POLICY_DIR / f"{name}.zip") if name in shipped_policy_names() else None
 
 

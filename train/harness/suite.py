@@ -56,7 +56,7 @@ from homing_train.harness.headline import (check_methods, headline_plan, headlin
                                            reading)
 from homing_train.harness.matrix import (BASE_PERIOD, applicable, equal_time_kwargs,
                                          matrix_markdown, run_matrix)
-from homing_train.harness.policies import DEFAULT_POLICY, shipped_policies
+from homing_train.harness.policies import DEFAULT_POLICY, resolved_name, shipped_policies
 from homing_train.harness.protocols import PROTOCOLS, protocol
 from homing_gym.outputs import OutputLock, output_dir_argument
 from homing_train.pool import WorkerDiedError, end_stopped_command
@@ -182,8 +182,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     check_backend_arguments(parser, args)
     if args.methods:                                  # the alias of the default policy
-        args.methods = list(dict.fromkeys(DEFAULT_POLICY if m == "ppo" else m
-                                          for m in args.methods))
+        args.methods = list(dict.fromkeys(map(resolved_name, args.methods)))
     if args.episodes is not None and args.episodes < 1:
         parser.error("--episodes must be >= 1")
     one_env = [flag for flag, value in (("--env", args.env), ("--env-kwargs", args.env_kwargs),
