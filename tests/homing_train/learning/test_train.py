@@ -291,7 +291,7 @@ def test_aligned_extractor_encodes_each_distinct_goal_once_with_the_same_result(
     # a hash shared by two different images: every image encoded, nothing merged
     extractor.hash_weights.zero_()
     assert extractor.distinct_images(close)[1] is None
-    extractor.hash_weights.copy_(torch.rand_like(extractor.hash_weights))
+    extractor.hash_weights.copy_(torch.randint_like(extractor.hash_weights, 1, 2 ** 16))
     # training (gradients on) gives the values and gradients of inference, image by image
     obs = {"panorama": torch.rand(6, 3, 8, 64), "goal": batch}
     out = extractor(obs)
@@ -305,6 +305,18 @@ def test_aligned_extractor_encodes_each_distinct_goal_once_with_the_same_result(
     whole.square().sum().backward()
     for got, want in zip(grads, (p.grad for p in extractor.parameters())):
         assert torch.allclose(got, want, rtol=1e-4, atol=1e-5)
+
+
+def test_equal_goals_anywhere_in_a_large_minibatch_are_encoded_once():
+    import gymnasium as gym
+
+    space = gym.spaces.Dict({k: gym.spaces.Box(0, 255, (3, 16, 64), np.uint8)
+                             for k in ("panorama", "goal")})
+    extractor = AlignedBandExtractor(space, features_dim=16)
+    goals = torch.rand(64, 3, 16, 64, generator=torch.Generator().manual_seed(3))
+    which = torch.randperm(512, generator=torch.Generator().manual_seed(4)) % 64
+    distinct, inverse = extractor.distinct_images(goals[which])
+    assert len(distinct) == 64 and torch.equal(distinct[inverse], goals[which])
 
 
 def test_extractor_kwargs_size_the_network_and_bad_ones_are_named():
