@@ -186,9 +186,9 @@ class AlignedBandExtractor(BaseFeaturesExtractor):
         with torch.no_grad():
             n_flat = self.head(torch.zeros(1, 3 * encoder[-1][0], width)).shape[1]
         self.log_temperature = nn.Parameter(torch.tensor(float(temperature)).log())
-        # random integer weights that hash an image to one number (not learned, not saved)
-        self.register_buffer("hash_weights", torch.randint(
-            1, 2 ** 16, (channels * rows * width,), generator=torch.Generator().manual_seed(0)),
+        # random weights that hash an image to one number (not learned, not saved)
+        self.register_buffer("hash_weights", torch.rand(
+            channels * rows * width, generator=torch.Generator().manual_seed(0)),
             persistent=False)
         self.linear = nn.Sequential(nn.Linear(n_flat + width, features_dim),
                                     nn.LayerNorm(features_dim))
@@ -212,11 +212,12 @@ class AlignedBandExtractor(BaseFeaturesExtractor):
         A PPO minibatch holds many samples of one episode, all with the same goal, so the
         goals are encoded once each. Found by hashing each image to one number and then
         checked exactly; ``inverse`` is ``None`` (use ``images`` as they are) when two
-        different images share a hash or nothing repeats. The hash is integer arithmetic
-        on the float32 bits, so equal images get equal hashes wherever they stand in the
-        batch (a float product's rounding depends on the BLAS kernel that computes it)."""
-        bits = images.float().contiguous().flatten(1).view(torch.int32).long()
-        keys, inverse = torch.unique((bits * self.hash_weights).sum(1), return_inverse=True)
+        different images share a hash or nothing repeats. The hash is a product summed
+        along each image alone (not a matrix product, whose rounding may differ with the
+        BLAS kernel that handles an image's row), so equal images share it wherever they
+        stand in the batch."""
+        flat = images.flatten(1)
+        keys, inverse = torch.unique((flat * self.hash_weights).sum(1), return_inverse=True)
         if len(keys) == len(images):
             return images, None
         rows = torch.arange(len(images), device=images.device)

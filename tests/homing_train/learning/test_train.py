@@ -291,7 +291,7 @@ def test_aligned_extractor_encodes_each_distinct_goal_once_with_the_same_result(
     # a hash shared by two different images: every image encoded, nothing merged
     extractor.hash_weights.zero_()
     assert extractor.distinct_images(close)[1] is None
-    extractor.hash_weights.copy_(torch.randint_like(extractor.hash_weights, 1, 2 ** 16))
+    extractor.hash_weights.copy_(torch.rand_like(extractor.hash_weights))
     # training (gradients on) gives the values and gradients of inference, image by image
     obs = {"panorama": torch.rand(6, 3, 8, 64), "goal": batch}
     out = extractor(obs)
