@@ -16,6 +16,8 @@ import math
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
+import numpy as np
+
 from homing_gym.render.panorama import N_VIEWS, PANORAMA_SHAPES, RENDERERS, CameraConfig
 from homing_gym.scenes.appearance import CAMERA_HEIGHT_RANGE
 from homing_gym.sim.robot import DRIVES, MAX_ODOMETRY_NOISE, RobotConfig
@@ -112,6 +114,31 @@ class Choices(Rule):
                                                              else "")
 
 
+@dataclass(frozen=True)
+class HeightOrRange(Rule):
+    """``None``, a real number in ``[low, high]``, or a pair ``(a, b)`` of them with
+    ``a <= b`` (stored as a tuple of floats)."""
+
+    text: str = ""
+    low: float = 0.0
+    high: float = 1.0
+
+    def check(self, name: str, value: Any, unit: str) -> float | tuple[float, float] | None:
+        if value is None or is_real(value):
+            return Range(low=self.low, high=self.high, optional=True).check(name, value, unit)
+        pair = require_sequence(name, value, 2, f"a number or a pair (low, high) in "
+                                f"{interval(self.low, self.high)} {unit}")
+        low, high = (require_number(name, v, self.low, self.high, unit) for v in pair)
+        if low > high:
+            raise ValueError(f"{name} {value!r}: the pair's low end is above its high end; "
+                             f"give (low, high) with low <= high")
+        return (low, high)
+
+    def __str__(self) -> str:
+        return (f"{interval(self.low, self.high)}, a pair (low, high) in it, or `None`"
+                + (f"; {self.text}" if self.text else ""))
+
+
 def _arg(default: Any, allowed: Rule, unit: str, meaning: str) -> Any:
     """A field of :class:`EnvConfig` with its row of the field table."""
     return dataclasses.field(default=default, metadata={"allowed": allowed, "unit": unit,
@@ -156,11 +183,11 @@ class EnvConfig:
     shadows: bool | None = _arg(None, Rule(f"`True`, `False`, `None`; {RAYCAST_ONLY}"), "",
                                 "objects cast shadows from the scene light (`None`: as the "
                                 "world says, else none)")
-    camera_height: float | None = _arg(
-        None, Range(low=CAMERA_HEIGHT_RANGE[0], high=CAMERA_HEIGHT_RANGE[1], optional=True),
-        "metres", f"camera above the floor (`None`: the world's, else "
-        f"{RobotConfig.camera_height:g}; below the robot's top, about 0.1 m, only the ray "
-        f"caster does not see the robot's body)")
+    camera_height: float | tuple[float, float] | None = _arg(
+        None, HeightOrRange(low=CAMERA_HEIGHT_RANGE[0], high=CAMERA_HEIGHT_RANGE[1]),
+        "metres", f"camera above the floor (a pair: each episode's drawn uniformly from it; "
+        f"`None`: the world's, else {RobotConfig.camera_height:g}; below the robot's top, "
+        f"about 0.1 m, only the ray caster does not see the robot's body)")
     action_type: str = _arg("continuous", Choices(values=ACTION_TYPES), "",
                             "`Box(-1, 1, (2,))` (forward, yaw rate) or `Discrete(4)`")
     drive: str = _arg(RobotConfig.drive, Choices(values=DRIVES), "",
@@ -249,10 +276,15 @@ class EnvConfig:
             raise ValueError("drive='synchro' takes continuous actions (vx, vy); got "
                              f"action_type={self.action_type!r}")
 
-    def robot(self, world_camera_height: float | None = None) -> RobotConfig:
-        """The robot's settings, its camera ``camera_height`` metres up, else
+    def robot(self, world_camera_height: float | None = None,
+              rng: np.random.Generator | None = None) -> RobotConfig:
+        """The robot's settings, its camera ``camera_height`` metres up (a pair: drawn
+        uniformly from it by ``rng``, its low end without one), else
         ``world_camera_height`` (a world's appearance), else the robot's default."""
-        height = next((h for h in (self.camera_height, world_camera_height) if h is not None),
+        height = self.camera_height
+        if isinstance(height, tuple):
+            height = height[0] if rng is None else float(rng.uniform(*height))
+        height = next((h for h in (height, world_camera_height) if h is not None),
                       RobotConfig.camera_height)
         return RobotConfig(max_speed=self.max_speed, max_yaw_rate=self.max_yaw_rate,
                            camera_height=height, drive=self.drive)

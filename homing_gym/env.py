@@ -269,9 +269,9 @@ class HomingEnv(gym.Env):
     def _use_appearance(self) -> None:
         """Take the current world's light and camera height
         (:class:`~homing_gym.scenes.appearance.Appearance`; the env's ``camera_height``
-        wins over the world's)."""
+        wins over the world's; a pair of them draws the episode's from ``np_random``)."""
         self._world_lighting = world_lighting(self.scene.appearance)
-        robot = self.config.robot(self.scene.appearance.camera_height)
+        robot = self.config.robot(self.scene.appearance.camera_height, self.np_random)
         if robot != self.robot_config:
             self.robot_config = robot
             self.camera.camera_height = robot.camera_height

@@ -99,6 +99,36 @@ def test_a_new_world_brings_its_own_camera_height():
     env.close()
 
 
+def test_a_camera_height_range_draws_each_episodes_height_and_renders_from_it():
+    env = _env(_arena(camera_height=0.05), camera_height=(0.1, 0.4))   # the env's wins
+    u = env.unwrapped
+    camera = CameraConfig(panorama_shape=SHAPE, vfov=math.radians(VFOV))
+    heights = []
+    for seed in range(8):
+        obs, _ = env.reset(seed=seed)
+        h = u.camera.camera_height
+        assert u.robot_config.camera_height == h and 0.1 <= h <= 0.4
+        np.testing.assert_array_equal(obs["panorama"], u.sim.caster.panorama(u.pose, h, camera))
+        np.testing.assert_array_equal(obs["goal"], u.sim.caster.panorama(u.episode.home, h,
+                                                                         camera))
+        heights.append(h)
+    assert len(set(heights)) == 8 and max(heights) - min(heights) > 0.1
+    again, _ = env.reset(seed=3)                  # a seed gives its height and its episode
+    assert u.camera.camera_height == heights[3]
+    env.close()
+
+
+@pytest.mark.parametrize("value, words", [
+    ((0.4, 0.1), ["camera_height", "(0.4, 0.1)", "low <= high"]),
+    ((0.1, 9.0), ["camera_height", "9", "[0.005, 5]"]),
+    ((0.1,), ["camera_height", "pair (low, high)"]),
+])
+def test_a_bad_camera_height_range_is_refused_by_name(value, words):
+    with pytest.raises(ValueError) as error:
+        _env(_arena(), camera_height=value)
+    assert all(w in str(error.value) for w in words), str(error.value)
+
+
 @pytest.mark.parametrize("env_shadows, expected", [(None, True), (False, False)])
 def test_the_worlds_shadows_unless_the_env_says(env_shadows, expected):
     env = _env(_arena(shadows=True), shadows=env_shadows)
