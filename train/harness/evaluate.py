@@ -625,9 +625,12 @@ def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int =
              params: dict[str, Any] | None = None, bin_width: float = 0.3,
              progress: bool = True, stream: str | None = None,
              resume: bool = False, tasks: Sequence[tuple] | None = None,
-             backend: str = "local", address: str | None = None) -> EvalResult:
+             backend: str = "local", address: str | None = None,
+             use_record: bool = True) -> EvalResult:
     """Evaluate ``policy`` (controller name, controller, :class:`PolicySpec` or SB3 zip
-    path) on episodes seeded ``seed .. seed + episodes - 1``, or on ``tasks``
+    path; a zip under the settings recorded beside it, given ``env_kwargs`` and
+    ``params`` winning, unless not ``use_record``: a protocol's cell has chosen what of
+    the record applies) on episodes seeded ``seed .. seed + episodes - 1``, or on ``tasks``
     ``[(seed, start pose or None, home pose or None), ...]`` (distinct seeds; then
     ``episodes`` and ``seed`` are taken from them).
 
@@ -653,7 +656,7 @@ def evaluate(policy, env_id: str = DEFAULT_ENV, episodes: int = 100, seed: int =
     check_env_id(env_id)
     spec = policy_spec(policy, params)
     env_kwargs = dict(env_kwargs or {})
-    if spec.kind == "sb3":
+    if spec.kind == "sb3" and use_record:
         # a zip is evaluated as it was shipped; explicit settings override the record
         recorded = recorded_settings(spec.source)
         env_kwargs = {**recorded.env_kwargs, **env_kwargs}

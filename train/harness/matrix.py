@@ -229,7 +229,7 @@ def run_cell(protocol: Protocol, method: str, out: Path, episodes: int | None = 
                           params=params, progress=progress,
                           stream=f"{stem}.episodes.jsonl", resume=resume,
                           tasks=setting.episode_tasks(n, protocol.seed), backend=backend,
-                          address=address)
+                          address=address, use_record=False)    # equal_time_kwargs chose
         result.save(f"{stem}.json")
         records += result.episodes
         per_setting[setting.label] = {

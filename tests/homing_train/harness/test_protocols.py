@@ -161,14 +161,16 @@ def test_oracle_cell_on_yukim_stops_at_the_nest_and_its_command_reproduces_it(tm
 
 
 def test_a_run_folders_model_runs_a_protocol_with_its_training_env_kwargs(tmp_path):
-    """A PPO zip given by path (here a band-extractor model) gets its run folder's env
-    kwargs (16 x 64 panoramas) under the protocol's own scene and stop rule."""
+    """A PPO zip given by path (here a band-extractor model) gets its run folder's input
+    format (16 x 64 panoramas) under the protocol's own scene, stop rule and time, and
+    nothing else of its training env: not its camera height or lighting."""
     from homing_train.learning.train import main as train_main
 
     run = tmp_path / "run"
     train_main(["--timesteps", "64", "--out", str(run), "--extractor", "band", "--n-envs", "1",
                 "--vec", "dummy", "--no-progress", "--env-kwargs",
-                json.dumps({"panorama_shape": [16, 64], "max_episode_steps": 16}),
+                json.dumps({"panorama_shape": [16, 64], "max_episode_steps": 16,
+                            "camera_height": 0.1, "lighting_change": 0.5}),
                 "--hp", "n_steps=64", "--hp", "batch_size=32", "--hp", "n_epochs=1",
                 "--hp", "features_dim=32"])
     model = str(run / "model.zip")
@@ -179,6 +181,8 @@ def test_a_run_folders_model_runs_a_protocol_with_its_training_env_kwargs(tmp_pa
     assert setting["env_kwargs"]["panorama_shape"] == [16, 64]
     assert setting["env_kwargs"]["scene"] == "arena"
     assert setting["env_kwargs"]["success_on"] == "stop"
+    assert "camera_height" not in setting["env_kwargs"]
+    assert "lighting_change" not in setting["env_kwargs"]
     assert cell.privileged == ""                # no warm start from the oracle
     with pytest.raises(ValueError, match="or a PPO model .zip"):
         run_cell(protocol("yukim"), str(tmp_path / "missing.zip"), tmp_path / "x")
