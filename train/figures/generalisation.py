@@ -10,7 +10,10 @@ method in its fixed colour, Wilson 95 % intervals, episodes per bar in the legen
 episodes together) and ``failures.png`` (for each method that failed
 at all, its failed episode of the lowest seed in each scene seen from above, labelled
 with its final distance: the world rebuilt from the episode's seed, the path in orange,
-home in green with the success circle, the end in blue, 1 m scale bar). Nothing is run but the worlds' construction; the episodes come from the folder.
+home in green with the success circle, the end in blue, 1 m scale bar), and where the
+worlds' camera heights differ (the world families), ``by_camera_height.md`` (success per
+0.1 m of the camera's height above the floor). Nothing is run but the worlds'
+construction; the episodes come from the folder.
 """
 
 from __future__ import annotations
@@ -122,6 +125,50 @@ def by_distance_figure(results: dict[str, list[SceneResult]], path: Path,
     plt.close(fig)
 
 
+def episode_camera_heights(result: SceneResult, worlds: dict) -> list[float]:
+    """The camera's height (metres) in each episode of ``result``: the env of its setting
+    reset with the episode's seed (the world rebuilt, the height its appearance's or the
+    env's); ``worlds`` caches them by env and seed, for the methods that share episodes."""
+    spec = result.result
+    key = (spec.env_id, json.dumps(spec.env_kwargs.get("scene")),
+           json.dumps(spec.env_kwargs.get("camera_height")))
+    heights = worlds.setdefault(key, {})
+    todo = [e.seed for e in result.episodes if e.seed not in heights]
+    if todo:
+        env = gym.make(spec.env_id, **spec.env_kwargs)
+        try:
+            for seed in todo:
+                env.reset(seed=seed)
+                heights[seed] = env.unwrapped.camera.camera_height
+        finally:
+            env.close()
+    return [heights[e.seed] for e in result.episodes]
+
+
+def by_camera_height_markdown(results: dict[str, list[SceneResult]],
+                              width: float = 0.1) -> str | None:
+    """Success % [Wilson 95 % interval] (episodes) per method by the camera's height in
+    ``width`` metre bins (every setting's episodes together); ``None`` when every episode
+    had the same height."""
+    worlds: dict = {}
+    heights = {m: [h for r in rows for h in episode_camera_heights(r, worlds)]
+               for m, rows in results.items()}
+    if len({round(h, 9) for hs in heights.values() for h in hs}) < 2:
+        return None
+    edges = sorted({(b.lo, b.hi) for m, rows in results.items()
+                    for b in distance_bins(heights[m], [e.success for r in rows
+                                                        for e in r.episodes], width)})
+    lines = ["| method | " + " | ".join(f"{lo:g}-{hi:g} m" for lo, hi in edges) + " |",
+             "|---|" + "---:|" * len(edges)]
+    for method, rows in results.items():
+        found = {(b.lo, b.hi): b for b in distance_bins(
+            heights[method], [e.success for r in rows for e in r.episodes], width)}
+        lines.append(f"| {method} | " + " | ".join(
+            _rate(round(found[k].success_rate * found[k].n), found[k].n) if k in found else "-"
+            for k in edges) + " |")
+    return "\n".join(lines)
+
+
 def per_scene_figure(results: dict[str, list[SceneResult]], path: Path) -> None:
     """Grouped bars: success % per scene, one bar per method, Wilson 95 % intervals."""
     import matplotlib
@@ -222,7 +269,11 @@ def main(argv: list[str] | None = None) -> int:
     per_scene_figure(results, out / "per_scene.png")
     by_distance_figure(results, out / "by_distance.png")
     failures_figure(results, out / "failures.png")
-    print(f"wrote {out}/per_scene.md, per_scene.png, by_distance.png, failures.png")
+    heights = by_camera_height_markdown(results)
+    if heights is not None:
+        (out / "by_camera_height.md").write_text(heights + "\n")
+    print(f"wrote {out}/per_scene.md, per_scene.png, by_distance.png, failures.png"
+          + (", by_camera_height.md" if heights is not None else ""))
     return 0
 
 

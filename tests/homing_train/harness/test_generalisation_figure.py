@@ -6,7 +6,8 @@ import imageio.v2 as imageio
 import numpy as np
 import pytest
 
-from homing_train.figures.generalisation import (TILE, failures_figure, load_results,
+from homing_train.figures.generalisation import (TILE, by_camera_height_markdown,
+                                                 failures_figure, load_results,
                                                  per_scene_markdown)
 from homing_train.harness.evaluate import EpisodeRecord, EvalResult
 from homing_train.harness.matrix import setting_stem
@@ -22,12 +23,15 @@ def _episode(seed: int, success: bool) -> EpisodeRecord:
                          trajectory=[[0.5, 0.0], [0.2, 0.1], [-0.1, 0.2]])
 
 
-def _write_cell(folder, method: str, outcomes: dict[str, list[bool]]) -> None:
-    """A method's cell as run_cell writes it: one result JSON per setting, cell.json."""
+def _write_cell(folder, method: str, outcomes: dict[str, list[bool]],
+                kwargs: dict[str, dict] | None = None) -> None:
+    """A method's cell as run_cell writes it: one result JSON per setting (env kwargs
+    ``kwargs[label]``, else the arena's), cell.json."""
     cell = folder / method
     cell.mkdir(parents=True)
     for label, successes in outcomes.items():
-        EvalResult(method, {}, "homing_gym/LocalHoming-v0", {"scene": "arena"}, 0,
+        env_kwargs = (kwargs or {}).get(label, {"scene": "arena"})
+        EvalResult(method, {}, "homing_gym/LocalHoming-v0", env_kwargs, 0,
                    [_episode(s, ok) for s, ok in enumerate(successes)]).save(
             str(cell / f"{setting_stem(label)}.json"))
     (cell / "cell.json").write_text(json.dumps({"method": method, "settings": {
@@ -72,3 +76,21 @@ def test_the_command_writes_the_table_and_three_figures(tmp_path):
     written = sorted(p.name for p in (tmp_path / "out").iterdir())
     assert written == ["by_distance.png", "failures.png", "per_scene.md", "per_scene.png"]
     assert imageio.imread(tmp_path / "out" / "by_distance.png").ndim == 3
+
+
+def test_success_by_camera_height_bins_every_settings_episodes_by_their_worlds_height(tmp_path):
+    low, high = {"scene": "arena", "camera_height": 0.05}, {"scene": "arena", "camera_height": 0.35}
+    _write_cell(tmp_path, "warping", {"low": [True, True, True], "high": [False, True]},
+                {"low": low, "high": high})
+    _write_cell(tmp_path, "snapshot", {"low": [False, False, True], "high": [False, False]},
+                {"low": low, "high": high})
+    table = by_camera_height_markdown(load_results(tmp_path)).splitlines()
+    assert table[0] == "| method | 0-0.1 m | 0.3-0.4 m |"
+    # 3 of 3: Wilson 95 % [44, 100]; 1 of 2: [9, 91]; 1 of 3: [6, 79]; 0 of 2: [0, 66]
+    assert "| warping | 100 [44, 100] (3) | 50 [9, 91] (2) |" in table
+    assert "| snapshot | 33 [6, 79] (3) | 0 [0, 66] (2) |" in table
+
+
+def test_no_camera_height_table_when_every_world_has_the_same_camera(tmp_path):
+    _write_cell(tmp_path, "warping", {"arena": [True, False]})
+    assert by_camera_height_markdown(load_results(tmp_path)) is None
