@@ -29,7 +29,6 @@ from __future__ import annotations
 import contextlib
 import csv
 import json
-import os
 import re
 import sys
 import time
@@ -48,8 +47,7 @@ import homing_baselines  # noqa: E402
 from homing_gym.cli import command_parser  # noqa: E402
 from homing_train.extras import missing_extra  # noqa: E402
 from homing_train.harness.evaluate import EpisodeRecord, evaluate, summarize  # noqa: E402
-from homing_train.harness.policies import (ShippedPolicy,  # noqa: E402
-                                           recorded_settings, resolved_name,
+from homing_train.harness.policies import (model_zips, resolved_name,  # noqa: E402
                                            shipped_policies)
 from homing_train.harness.metrics import aggregate_success, wilson_interval  # noqa: E402
 from homing_train.harness.protocols import (POLICIES, PROTOCOLS, Protocol,  # noqa: E402
@@ -196,11 +194,7 @@ def run_cell(protocol: Protocol, method: str, out: Path, episodes: int | None = 
     n = protocol.episodes if episodes is None else episodes
     if n < 1:
         raise ValueError(f"episodes must be >= 1, got {n}")
-    shipped = shipped_for(protocol_policy_envs(protocol))
-    if method.endswith(".zip") and os.path.isfile(method):
-        recorded = recorded_settings(method)
-        shipped[method] = ShippedPolicy(Path(method), recorded.env_kwargs, recorded.params,
-                                        recorded.env_id, recorded.privileged)
+    shipped = {**shipped_for(protocol_policy_envs(protocol)), **model_zips([method])}
     if method not in shipped and method not in homing_baselines.available():
         raise ValueError(f"unknown method {method!r} for protocol {protocol.name!r}; "
                          f"allowed: {cell_methods(protocol)} or a PPO model .zip")

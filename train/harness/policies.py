@@ -339,12 +339,21 @@ class ShippedPolicy:
     privileged: str = ""        # what beyond pixels its training used ("" if nothing)
 
 
+def model_policy(model: Path) -> ShippedPolicy:
+    """The PPO zip ``model`` with the evaluation settings recorded beside it
+    (:func:`recorded_settings`: a shipped policy's ``.yml``, a run folder's config)."""
+    settings = recorded_settings(str(model))
+    return ShippedPolicy(Path(model), settings.env_kwargs, settings.params, settings.env_id,
+                         settings.privileged)
+
+
+def model_zips(methods: list[str] | None) -> dict[str, ShippedPolicy]:
+    """The methods among ``methods`` that name an existing ``.zip`` file, as policies."""
+    return {m: model_policy(Path(m)) for m in methods or []
+            if m.endswith(".zip") and os.path.isfile(m)}
+
+
 def shipped_policies(folder: Path = POLICY_DIR) -> dict[str, ShippedPolicy]:
     """Shipped PPO policies by name, with their recorded evaluation settings
     (:func:`recorded_settings`)."""
-    found = {}
-    for model in sorted(folder.glob("*.zip")):
-        settings = recorded_settings(str(model))
-        found[model.stem] = ShippedPolicy(model, settings.env_kwargs, settings.params,
-                                          settings.env_id, settings.privileged)
-    return found
+    return {model.stem: model_policy(model) for model in sorted(folder.glob("*.zip"))}

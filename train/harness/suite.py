@@ -13,7 +13,8 @@ and the default learned policy (``ppo_procedural_long``), a few episodes per pro
 (about 4 minutes on 2 cores); it prints the methods x protocols table (success with 95%
 intervals and the episodes per cell) and a reading of it, and writes the matrix files
 and each cell's files into ``--out``. ``--episodes N`` runs N per setting of every protocol instead,
-``--methods`` a subset (a shipped policy by name too).
+``--methods`` a subset (a shipped policy by name too; in the one-env comparison also a
+PPO model zip by path, e.g. ``runs/RUN/model.zip``, under its recorded input format).
 
 ``--protocols NAME ...`` (``all``: every protocol, the paper-like counts) runs every
 applicable method on each protocol (:mod:`homing_train.harness.protocols`, one success
@@ -56,7 +57,8 @@ from homing_train.harness.headline import (check_methods, headline_plan, headlin
                                            reading)
 from homing_train.harness.matrix import (BASE_PERIOD, applicable, equal_time_kwargs,
                                          matrix_markdown, run_matrix)
-from homing_train.harness.policies import DEFAULT_POLICY, resolved_name, shipped_policies
+from homing_train.harness.policies import (DEFAULT_POLICY, model_zips, resolved_name,
+                                           shipped_policies)
 from homing_train.harness.protocols import PROTOCOLS, protocol
 from homing_gym.outputs import OutputLock, output_dir_argument
 from homing_train.pool import WorkerDiedError, end_stopped_command
@@ -83,6 +85,15 @@ def scene_name(env_id: str, env_kwargs: dict[str, Any] | None = None) -> str:
         env.close()
 
 
+def result_stem(method: str) -> str:
+    """The file name (without extension) of ``method``'s results: its name, or for a
+    model zip its path without ``.zip``, ``/`` as ``_`` (``runs/a/model.zip`` ->
+    ``runs_a_model``)."""
+    if not method.endswith(".zip"):
+        return method
+    return Path(method).with_suffix("").as_posix().lstrip("./").replace("/", "_")
+
+
 def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: int = 0,
               workers: int = 2, methods: list[str] | None = None, backend: str = "local",
               address: str | None = None, success_on: str = "stop",
@@ -106,7 +117,7 @@ def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: in
     if "success_on" in env_kwargs:
         raise ValueError(f"env kwargs set success_on={env_kwargs['success_on']!r}; the suite's "
                          f"one success rule is --success-on (stop or reach)")
-    policies = {name: p for name, p in shipped_policies().items()
+    policies = {name: p for name, p in {**shipped_policies(), **model_zips(methods)}.items()
                 if p.env_id in (None, env_id)}
     if policies and (hint := missing_extra("train")):
         print(f"homing-suite: the learned rows {sorted(policies)} are left out ({hint})")
@@ -116,7 +127,8 @@ def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: in
     chosen = methods or made_for + sorted(policies)
     unknown = sorted(set(chosen) - set(candidates))
     if unknown:
-        raise ValueError(f"unknown methods {unknown}; available: {candidates}")
+        raise ValueError(f"unknown methods {unknown}; available: {candidates}, or the path "
+                         f"of a PPO model .zip trained on {env_id}")
     chosen = applicable(chosen, set(made_for) | set(policies),
                         lambda: f"{env_id} in scene {scene_name(env_id, env_kwargs)!r}")
     learned = sorted(set(chosen) & set(policies))
@@ -129,10 +141,10 @@ def run_suite(out: Path, env_id: str = DEFAULT_ENV, episodes: int = 20, seed: in
             str(shipped.path),
             equal_time_kwargs(setting, shipped.env_kwargs, gym.spec(env_id).max_episode_steps),
             shipped.params) if shipped else (name, setting, {})
-        path = out / f"{name}.json"
+        path = out / f"{result_stem(name)}.json"
         result = evaluate(policy, env_id, episodes=episodes, seed=seed, env_kwargs=kwargs,
                           workers=workers, params=params, backend=backend, address=address,
-                          stream=stream_path(str(path)), resume=resume)
+                          stream=stream_path(str(path)), resume=resume, use_record=False)
         print(format_summary(result))
         result.save(str(path))
         paths.append(str(path))

@@ -346,6 +346,32 @@ def test_the_suite_gives_a_shipped_policy_the_controllers_time(monkeypatch, tmp_
     assert kwargs["control_period"] == 0.2 and kwargs["max_episode_steps"] == 250
 
 
+def test_the_suite_runs_a_model_zip_by_path_under_its_input_format_only(tmp_path):
+    """A run folder's zip (trained with 16 x 64 panoramas, a 16-step cap and the camera
+    at 0.1 m) is a row beside the controllers: its input format, the suite's world, rule
+    and time (500 steps of 0.1 s), not its camera."""
+    from homing_train.harness import suite
+    from homing_train.learning.train import main as train_main
+
+    run = tmp_path / "run"
+    train_main(["--timesteps", "64", "--out", str(run), "--extractor", "band", "--n-envs", "1",
+                "--vec", "dummy", "--no-progress", "--env-kwargs",
+                json.dumps({"panorama_shape": [16, 64], "max_episode_steps": 16,
+                            "camera_height": 0.1}),
+                "--hp", "n_steps=64", "--hp", "batch_size=32", "--hp", "n_epochs=1",
+                "--hp", "features_dim=32"])
+    model = str(run / "model.zip")
+    suite.run_suite(tmp_path / "out", episodes=1, workers=1, methods=["random", model])
+    stem = suite.result_stem(model)
+    assert "/" not in stem and stem.endswith("run_model")
+    kwargs = json.loads((tmp_path / "out" / f"{stem}.json").read_text())["env_kwargs"]
+    assert kwargs["panorama_shape"] == [16, 64] and kwargs["success_on"] == "stop"
+    assert kwargs["max_episode_steps"] == 500 and "camera_height" not in kwargs
+    with pytest.raises(ValueError, match="or the path of a PPO model .zip"):
+        suite.run_suite(tmp_path / "x", episodes=1, workers=1,
+                        methods=[str(tmp_path / "missing.zip")])
+
+
 @pytest.mark.parametrize("rule", ["stop", "reach"])
 def test_every_row_of_the_suite_has_one_success_rule(monkeypatch, tmp_path, rule):
     # ppo_procedural_long trained with success_on="stop"; a controller row has no rule of its
