@@ -26,6 +26,10 @@ from homing_baselines import Controller
 SB3_PARAMS: dict[str, Any] = {"deterministic": True, "trust": False}
 
 
+#: The model files every ``homing-train`` run writes (named by their run folder in results).
+RUN_MODEL_NAMES = ("model", "best_model")
+
+
 @dataclass
 class PolicySpec:
     """``kind`` is ``"controller"`` (``source`` = registry name, ``params`` overrides,
@@ -38,10 +42,17 @@ class PolicySpec:
 
     @property
     def label(self) -> str:
-        """Name used in results and plots."""
-        if self.kind == "sb3":
-            return os.path.splitext(os.path.basename(self.source))[0]
-        return self.source
+        """Name used in results and plots: a controller's name, a zip's file name without
+        ``.zip``, led by its run folder's name where the file is one every run writes
+        (``runs/abc/model.zip`` -> ``abc/model``, ``runs/abc/checkpoints/ppo_8_steps.zip``
+        -> ``abc/ppo_8_steps``)."""
+        if self.kind != "sb3":
+            return self.source
+        path = Path(self.source)
+        checkpoint = path.parent.name == "checkpoints"
+        run = (path.parent.parent if checkpoint else path.parent).name
+        generic = checkpoint or path.stem in RUN_MODEL_NAMES
+        return f"{run}/{path.stem}" if generic and run else path.stem
 
     @property
     def sequential(self) -> bool:

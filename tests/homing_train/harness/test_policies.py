@@ -4,7 +4,7 @@ import yaml
 
 import pytest
 
-from homing_train.harness.policies import (DEFAULT_POLICY, POLICY_DIR, policy_spec,
+from homing_train.harness.policies import (DEFAULT_POLICY, POLICY_DIR, PolicySpec, policy_spec,
                                            recorded_settings)
 
 
@@ -24,6 +24,14 @@ def test_a_run_folders_models_and_checkpoints_take_the_runs_training_settings(tm
     (run / "config.yml").write_text(yaml.safe_dump({**config, "eval_deterministic": False}))
     assert recorded_settings(str(run / "best_model.zip")).params == {"deterministic": False}
     assert recorded_settings(str(tmp_path / "elsewhere.zip")).env_kwargs == {}
+
+
+@pytest.mark.parametrize("path, label", [
+    ("runs/abc/model.zip", "abc/model"), ("runs/abc/best_model.zip", "abc/best_model"),
+    ("runs/abc/checkpoints/ppo_8_steps.zip", "abc/ppo_8_steps"),
+    ("train/shipped/ppo_procedural_long.zip", "ppo_procedural_long"), ("model.zip", "model")])
+def test_a_models_label_names_its_run_where_the_file_name_is_every_runs(path, label):
+    assert PolicySpec("sb3", path).label == label
 
 
 def test_ppo_and_shipped_names_are_policies():
