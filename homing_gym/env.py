@@ -183,6 +183,7 @@ class HomingEnv(gym.Env):
         self.collisions = 0
         self._panorama: np.ndarray | None = None   # rendered on first use after a move
         self._last_obs: dict[str, np.ndarray] = {}
+        self._previous_panorama: np.ndarray | None = None   # the last observation's view
         self._skip_images = False
         self.goal_index = 0
         self._goal_views: list[dict[str, np.ndarray] | None] = []
@@ -344,7 +345,8 @@ class HomingEnv(gym.Env):
         :meth:`advance` returns it after :meth:`skip_next_images`), the rendered keys
         repeat their last value."""
         sight = Sight(self.camera, lambda: self.panorama, odometry=lambda: self.odometry.estimate,
-                      view=lambda size, hfov: self.render_view(size=size, hfov_deg=hfov))
+                      view=lambda size, hfov: self.render_view(size=size, hfov_deg=hfov),
+                      previous=lambda: self._previous_panorama)
         obs: dict[str, np.ndarray] = {}
         for key, entry in self._table.items():
             if entry.goal:
@@ -353,6 +355,8 @@ class HomingEnv(gym.Env):
                 obs[key] = self._last_obs[key].copy()
             else:
                 obs[key] = entry.produce(sight)
+        if "previous" in self._table and not (skip_images and self._last_obs):
+            self._previous_panorama = self.panorama.copy()     # the next step's "previous"
         self._last_obs = obs
         return obs
 
@@ -450,6 +454,7 @@ class HomingEnv(gym.Env):
         self._panorama = None
         self._skip_images = False
         self._last_obs = {}
+        self._previous_panorama = None
         self.trajectory = [(float(self.pose[0]), float(self.pose[1]))]
         self.collisions = 0
         self.task.on_reset(self._task_context)

@@ -72,6 +72,7 @@ class LocalHomingEnv(HomingEnv):
     |---|---|---|
     | `panorama` | `Box(0, 255, (H, W, 3), uint8)` | current cylindrical panorama, default 48 x 256 (1.41 deg/column, 1.25 deg/row) |
     | `goal` | same | panorama taken at the home pose |
+    | `previous` | same | the panorama of the step before (at reset: the current one): what changed since |
     | `goal_step` | same | panorama taken `goal_step_length` (0.15 m) straight ahead of home: a second nest snapshot (Yu & Kim §II-A) |
     | `omni`, `goal_omni` | `Box(0, 255, (S, S, 3), uint8)` | catadioptric ring images, default S = 128 |
     | `signature`, `goal_signature` | `Box(0, 1, (W,), float32)` | Hong 1991 horizon signatures |
@@ -198,9 +199,9 @@ class RouteFollowingEnv(HomingEnv):
     ## Observation space
 
     As ``LocalHoming-v0`` (``obs_keys``): ``panorama``, ``goal`` (the current target's
-    snapshot), optional ``omni``, ``goal_omni``, ``signature``, ``goal_signature``,
-    ``odometry`` (zero at the start; with ``odometry_origin="home"`` the pose in the
-    frame of the last target), and, only when asked for, the route's teaching views:
+    snapshot), optional ``previous``, ``omni``, ``goal_omni``, ``signature``,
+    ``goal_signature``, ``odometry`` (zero at the start; with ``odometry_origin="home"``
+    the pose in the frame of the last target), and, only when asked for, the route's teaching views:
 
     | key | space | meaning |
     |---|---|---|

@@ -28,14 +28,18 @@ class Sight:
     the signature derived from a panorama); ``odometry``: the wheel-odometry estimate
     ``(x, y, yaw)`` (metres, radians), or ``None`` for a goal snapshot;
     ``panorama_ahead(d)``: the panorama ``d`` metres straight ahead (goal snapshots only);
-    ``view(size, hfov_deg)``: an ordinary perspective view (current pose only)."""
+    ``view(size, hfov_deg)``: an ordinary perspective view (current pose only);
+    ``previous``: the panorama of the step before (current pose only; at the episode's
+    first observation, the current panorama)."""
 
     def __init__(self, camera: PanoramaCamera, render: Callable[[], np.ndarray], *,
                  odometry: Callable[[], np.ndarray] | None = None,
                  ahead: Callable[[float], np.ndarray] | None = None,
-                 view: Callable[[tuple[int, int], float], np.ndarray] | None = None):
+                 view: Callable[[tuple[int, int], float], np.ndarray] | None = None,
+                 previous: Callable[[], np.ndarray | None] | None = None):
         self.camera = camera
         self._render, self._odometry, self._ahead, self._view = render, odometry, ahead, view
+        self._previous = previous
         self._panorama: np.ndarray | None = None
 
     @property
@@ -59,6 +63,13 @@ class Sight:
         if self._view is None:
             raise ValueError("only the current pose renders a perspective view")
         return self._view(size, hfov_deg)
+
+    @property
+    def previous(self) -> np.ndarray:
+        if self._previous is None:
+            raise ValueError("a goal snapshot has no previous step")
+        before = self._previous()
+        return (self.panorama if before is None else before).copy()
 
 
 @dataclass(frozen=True)
@@ -118,13 +129,14 @@ CORE_KEYS: dict[str, ObservationKey] = {
     "signature": ObservationKey(_signature, _signature_of),
     "odometry": ObservationKey(_pose, lambda sight: sight.odometry.astype(np.float32),
                                rendered=False),
+    "previous": ObservationKey(_image, lambda sight: sight.previous),
     "goal": ObservationKey(_image, _panorama, goal=True),
     "goal_omni": ObservationKey(_ring, _omni, goal=True),
     "goal_signature": ObservationKey(_signature, _signature_of, goal=True),
 }
 
 #: Keys read from the current pose's panorama (one ray-cast image per step).
-PANORAMA_KEYS = ("panorama", "omni", "signature")
+PANORAMA_KEYS = ("panorama", "omni", "signature", "previous")
 
 
 def constant_key(space: spaces.Space, value: Callable[[], np.ndarray]) -> ObservationKey:

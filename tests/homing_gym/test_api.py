@@ -64,6 +64,23 @@ def test_optional_observation_keys(make_env):
     assert env.observation_space.contains(obs)
 
 
+def test_previous_is_the_panorama_of_the_step_before(make_env):
+    """``previous``: the current panorama at reset, then each step the panorama the
+    step before showed; a reset starts again from the new view."""
+    env = make_env(obs_keys=("panorama", "goal", "previous"), action_type="discrete")
+    obs, _ = env.reset(seed=2)
+    np.testing.assert_array_equal(obs["previous"], obs["panorama"])
+    shown = [obs["panorama"]]
+    for action in (0, 1, 0, 2):                      # forward, turns: the view changes
+        obs, *_ = env.step(action)
+        np.testing.assert_array_equal(obs["previous"], shown[-1])
+        shown.append(obs["panorama"])
+    assert not np.array_equal(shown[-1], shown[-2])
+    obs, _ = env.reset(seed=3)
+    np.testing.assert_array_equal(obs["previous"], obs["panorama"])
+    assert env.observation_space.contains(obs)
+
+
 def test_goal_is_home_snapshot(make_env):
     """The goal image equals the panorama rendered at the home pose."""
     env = make_env()

@@ -106,12 +106,16 @@ def batch_transformed(images: np.ndarray, matrices: np.ndarray,
 
 class AugmentedImages(VecEnvWrapper):
     """A vector env (dict observations of HWC uint8 images, before SB3's channel-first
-    transpose) whose image keys ``image_keys`` go through each env's colour transform,
-    drawn anew (from ``seed``'s stream) whenever that env's episode starts."""
+    transpose) whose image keys ``image_keys`` (default: ``panorama``, ``goal`` and, where
+    observed, ``previous``) go through each env's colour transform, drawn anew (from
+    ``seed``'s stream) whenever that env's episode starts."""
 
     def __init__(self, venv, settings: AugmentSettings, seed: int,
-                 image_keys: tuple[str, ...] = ("panorama", "goal")):
+                 image_keys: tuple[str, ...] | None = None):
         super().__init__(venv)
+        if image_keys is None:
+            image_keys = ("panorama", "goal", *(("previous",) if "previous" in
+                                                venv.observation_space.spaces else ()))
         missing = [k for k in image_keys if k not in venv.observation_space.spaces]
         if missing:
             raise ValueError(f"augment needs the image keys {missing}; the observations have "

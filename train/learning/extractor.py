@@ -35,6 +35,8 @@ from torch.nn import functional as F
 
 from homing_train.learning import EXTRACTORS
 
+#: The observation key :class:`AlignedBandExtractor` reads as the step before's panorama.
+PREVIOUS_KEY = "previous"
 
 
 class CircularConv(nn.Module):
@@ -156,7 +158,12 @@ class AlignedBandExtractor(BaseFeaturesExtractor):
     them with ``p`` (the heading offset), and a linear layer and LayerNorm give
     ``features_dim`` values. Other keys are flattened and appended, as in
     :class:`PanoramaGoalExtractor`. ``encoder`` and ``head``: (channels, kernel, stride)
-    of each convolution; the encoder's strides must be 1 (one column per shift)."""
+    of each convolution; the encoder's strides must be 1 (one column per shift).
+
+    Where the observations hold ``previous`` (the panorama of the step before, as
+    ``obs_keys`` can add), it goes through the same encoder and the head also gets
+    ``f - f_prev``: what changed since the last step, which a reactive policy otherwise
+    cannot know (a robot pushing against a rock sees no change at all)."""
 
     def __init__(self, observation_space: gym.spaces.Dict, features_dim: int = 128,
                  image_keys: tuple[str, str] = ("panorama", "goal"),
@@ -174,17 +181,24 @@ class AlignedBandExtractor(BaseFeaturesExtractor):
         if any(stride != 1 for _, _, stride in encoder):
             raise ValueError(f"the encoder's strides must be 1 (one column per shift); got "
                              f"{encoder}")
-        extra_keys = [k for k in observation_space.spaces if k not in image_keys]
+        previous = PREVIOUS_KEY if PREVIOUS_KEY in observation_space.spaces else None
+        if previous is not None and observation_space[previous].shape not in shapes:
+            raise ValueError(f"{type(self).__name__}: observation {previous!r} must have the "
+                             f"images' shape {shapes}; got {observation_space[previous].shape}")
+        extra_keys = [k for k in observation_space.spaces
+                      if k not in image_keys and k != previous]
         extra_dim = sum(math.prod(observation_space[k].shape) for k in extra_keys)
         super().__init__(observation_space, features_dim + extra_dim)
         channels, rows, width = observation_space[image_keys[0]].shape
         self.image_keys = tuple(image_keys)
+        self.previous_key = previous
         self.extra_keys = tuple(extra_keys)
         self.encoder = nn.Sequential(*conv_layers(CircularConv1d, channels * rows, encoder))
-        self.head = nn.Sequential(nn.Sequential(*conv_layers(CircularConv1d, 3 * encoder[-1][0],
-                                                             head)), nn.Flatten())
+        head_in = (3 if previous is None else 4) * encoder[-1][0]
+        self.head = nn.Sequential(nn.Sequential(*conv_layers(CircularConv1d, head_in, head)),
+                                  nn.Flatten())
         with torch.no_grad():
-            n_flat = self.head(torch.zeros(1, 3 * encoder[-1][0], width)).shape[1]
+            n_flat = self.head(torch.zeros(1, head_in, width)).shape[1]
         self.log_temperature = nn.Parameter(torch.tensor(float(temperature)).log())
         # random weights that hash an image to one number (not learned, not saved)
         self.register_buffer("hash_weights", torch.rand(
@@ -243,15 +257,21 @@ class AlignedBandExtractor(BaseFeaturesExtractor):
         # both images through the encoder in one batch: half the calls, the same values
         goals, inverse = (self.distinct_images(goal) if torch.is_grad_enabled()
                           else (goal, None))
-        features = self.column_features(torch.cat([current, goals]))
-        f, g = features[:len(current)], features[len(current):]
+        views = [current] if self.previous_key is None else [current,
+                                                             observations[self.previous_key]]
+        features = self.column_features(torch.cat([*views, goals]))
+        n = len(current)
+        f, g = features[:n], features[len(views) * n:]
         if inverse is not None:
             g = g[inverse]
         p = self.shift_weights(f, g)
         width = f.shape[-1]
         aligned = torch.fft.irfft(torch.fft.rfft(g, dim=-1)
                                   * torch.fft.rfft(p, dim=-1).unsqueeze(1), n=width, dim=-1)
-        compared = self.head(torch.cat([f, aligned, f - aligned], dim=1))
+        parts = [f, aligned, f - aligned]
+        if self.previous_key is not None:
+            parts.append(f - features[n:2 * n])
+        compared = self.head(torch.cat(parts, dim=1))
         features = [self.linear(torch.cat([compared, p], dim=1))]
         features += [observations[k].flatten(1) for k in self.extra_keys]
         return torch.cat(features, dim=1)

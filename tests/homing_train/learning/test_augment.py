@@ -110,6 +110,23 @@ def test_each_episode_has_one_transform_for_both_images_and_the_next_a_new_one()
         assert not np.array_equal(after["goal"][i], first["goal"][i])
 
 
+def test_the_previous_view_is_augmented_in_its_episodes_colours():
+    class WithPrevious(_Pictures):
+        observation_space = gym.spaces.Dict({**_Pictures.observation_space.spaces,
+                                             "previous": _Pictures.observation_space["goal"]})
+
+        def __init__(self):
+            super().__init__()
+            self.obs["previous"] = self.obs["panorama"][::-1].copy()
+
+    raw = WithPrevious().obs
+    env = AugmentedImages(DummyVecEnv([WithPrevious]), AugmentSettings(), seed=3)
+    assert env.image_keys == ("panorama", "goal", "previous")
+    first = env.reset()
+    np.testing.assert_array_equal(first["previous"][0],
+                                  transformed(raw["previous"], *env._draws[0]))
+
+
 @pytest.mark.parametrize("value, match", [
     ({"hue": 4.0}, "augment hue"),
     ({"saturation": [1.2, 0.5]}, "min 1.2 above max 0.5"),

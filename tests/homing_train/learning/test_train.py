@@ -248,6 +248,33 @@ def test_aligned_extractor_rotates_the_goal_into_the_current_frame():
         AlignedBandExtractor(gym.spaces.Dict({"panorama": space["panorama"]}))
 
 
+def test_aligned_extractor_compares_the_view_with_the_step_before():
+    """With a ``previous`` key the head also sees what changed since the last step: a
+    view equal to the one before (the robot stuck) gives other features than a changed
+    one, the goal and the view being the same; without the key nothing changes."""
+    import gymnasium as gym
+
+    torch.manual_seed(3)
+    box = gym.spaces.Box(0, 255, (3, 8, 64), np.uint8)
+    space = gym.spaces.Dict({"panorama": box, "goal": box, "previous": box})
+    extractor = AlignedBandExtractor(space, features_dim=16)
+    assert extractor.previous_key == "previous" and extractor.features_dim == 16
+    current, goal = torch.rand(2, 3, 8, 64), torch.rand(2, 3, 8, 64)
+    still = extractor({"panorama": current, "goal": goal, "previous": current})
+    moved = extractor({"panorama": current, "goal": goal,
+                       "previous": torch.roll(current, 5, dims=-1)})
+    assert still.shape == moved.shape == (2, 16)
+    assert (still - moved).abs().max() > 1e-2
+    # the same weights read as a two-key extractor would, apart from the fourth input
+    plain = AlignedBandExtractor(gym.spaces.Dict({"panorama": box, "goal": box}),
+                                 features_dim=16)
+    assert plain.previous_key is None
+    assert plain.head[0][0].conv.in_channels * 4 == extractor.head[0][0].conv.in_channels * 3
+    with pytest.raises(ValueError, match="'previous' must have the images' shape"):
+        AlignedBandExtractor(gym.spaces.Dict({"panorama": box, "goal": box, "previous":
+                                              gym.spaces.Box(0, 255, (3, 4, 64), np.uint8)}))
+
+
 def test_aligned_extractor_column_features_are_standardised_unit_columns():
     """The sums in ``column_features`` compute what its docstring defines (torch's own
     ``std`` and ``F.normalize``, which the shipped policies were trained with)."""
