@@ -6,6 +6,8 @@ writes ``DIR/unseen/<method>/``).
 writes ``per_scene.png`` (success with the protocol's stop rule per scene, one bar per
 method in its fixed colour, Wilson 95 % intervals, episodes per bar in the legend),
 ``per_scene.md`` (the same as a table, with a column over all scenes),
+``failure_kinds.md`` (each method's failures by kind: stuck against something, out of
+time elsewhere, stopped near home, stopped away),
 ``by_distance.png`` (success against the start's distance from home, every scene's
 episodes together) and ``failures.png`` (for each method that failed
 at all, its failed episode of the lowest seed in each scene seen from above, labelled
@@ -34,7 +36,8 @@ from homing_gym.cli import command_parser
 from homing_gym.render.topdown import BG, MapCanvas, draw_scale_bar, draw_topdown, labelled
 from homing_train.harness.evaluate import EpisodeRecord, EvalResult
 from homing_train.harness.matrix import setting_stem
-from homing_train.harness.metrics import distance_bins, wilson_interval
+from homing_train.harness.metrics import (FAILURE_KINDS, distance_bins, failure_kind,
+                                          wilson_interval)
 from homing_train.harness.palette import method_color
 from homing_gym.outputs import output_dir_argument, save_figure
 
@@ -91,6 +94,24 @@ def per_scene_markdown(results: dict[str, list[SceneResult]]) -> str:
         cells = [_rate(r.successes, len(r.episodes)) for r in rows]
         cells.append(_rate(sum(r.successes for r in rows), sum(len(r.episodes) for r in rows)))
         lines.append(f"| {method} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def failure_kinds_markdown(results: dict[str, list[SceneResult]]) -> str:
+    """Per method, its episodes over all scenes by outcome: successes, then its failures
+    by kind (:func:`~homing_train.harness.metrics.failure_kind`), each a count."""
+    lines = ["| method | episodes | success | " + " | ".join(FAILURE_KINDS) + " |",
+             "|---|" + "---:|" * (len(FAILURE_KINDS) + 2)]
+    for method, rows in results.items():
+        counts = dict.fromkeys(FAILURE_KINDS, 0)
+        for row in rows:
+            for e in row.episodes:
+                if not e.success:
+                    counts[failure_kind(e.truncated, e.steps, e.collisions, e.final_distance,
+                                        row.result.success_radius)] += 1
+        n = sum(len(row.episodes) for row in rows)
+        lines.append(f"| {method} | {n} | {sum(r.successes for r in rows)} | "
+                     + " | ".join(str(counts[k]) for k in FAILURE_KINDS) + " |")
     return "\n".join(lines)
 
 
@@ -266,13 +287,15 @@ def main(argv: list[str] | None = None) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "per_scene.md").write_text(per_scene_markdown(results) + "\n")
+    (out / "failure_kinds.md").write_text(failure_kinds_markdown(results) + "\n")
     per_scene_figure(results, out / "per_scene.png")
     by_distance_figure(results, out / "by_distance.png")
     failures_figure(results, out / "failures.png")
     heights = by_camera_height_markdown(results)
     if heights is not None:
         (out / "by_camera_height.md").write_text(heights + "\n")
-    print(f"wrote {out}/per_scene.md, per_scene.png, by_distance.png, failures.png"
+    print(f"wrote {out}/per_scene.md, failure_kinds.md, per_scene.png, by_distance.png, "
+          f"failures.png"
           + (", by_camera_height.md" if heights is not None else ""))
     return 0
 

@@ -17,6 +17,9 @@ Definitions (metres, radians unless named otherwise):
   success radius of it, each target at a later position than the one before
   (:func:`targets_reached_in_order`); the episode is *reached* when every target was,
   in order, and *all targets within radius* when it left every target within the radius;
+* a failed episode's kind (:func:`failure_kind`): *stuck* (out of time, in contact with
+  something in at least 30 % of its steps), *out of time* (elsewhere), *stopped near*
+  (within 0.1 m beyond the success radius), *stopped away*;
 * confidence intervals from ``scipy.stats``: a success rate's is the Wilson score interval
   (:func:`wilson_interval`, ``binomtest(...).proportion_ci``), a continuous metric's the
   percentile bootstrap of its mean (:func:`bootstrap_ci`, ``scipy.stats.bootstrap``, seeded);
@@ -38,8 +41,9 @@ from scipy import stats
 
 from homing_gym.paths import path_length
 
-__all__ = ["Aggregate", "aggregate_success", "bootstrap_ci", "distance_bins", "path_length",
-           "soft_spl", "spl", "targets_reached_in_order", "wilson_interval"]
+__all__ = ["Aggregate", "FAILURE_KINDS", "aggregate_success", "bootstrap_ci", "distance_bins",
+           "failure_kind", "path_length", "soft_spl", "spl", "targets_reached_in_order",
+           "wilson_interval"]
 
 
 def spl(success: bool, shortest: float, path: float) -> float:
@@ -210,3 +214,22 @@ def distance_bins(start_distances, successes, width: float = 0.3) -> list[Distan
                                 n=int(member.size), success_rate=float(member.mean()),
                                 success_ci=wilson_interval(int(member.sum()), member.size)))
     return bins
+
+
+#: How a failed episode ended (:func:`failure_kind`), in the order tables list them.
+FAILURE_KINDS = ("stuck", "out of time", "stopped near", "stopped away")
+#: An episode out of time with contact in at least this fraction of its steps was stuck.
+STUCK_CONTACT = 0.3
+#: A stop at most this far (metres) beyond the success radius was near.
+NEAR_MARGIN = 0.1
+
+
+def failure_kind(truncated: bool, steps: int, collisions: int, final_distance: float,
+                 radius: float) -> str:
+    """What a failed episode did: out of time with contact (robot against a wall or
+    object) in at least :data:`STUCK_CONTACT` of its ``steps``, ``"stuck"``; out of time
+    otherwise, ``"out of time"``; ended (stopped) within ``radius`` +
+    :data:`NEAR_MARGIN` metres of home, ``"stopped near"``; farther, ``"stopped away"``."""
+    if truncated:
+        return "stuck" if collisions >= STUCK_CONTACT * max(steps, 1) else "out of time"
+    return "stopped near" if final_distance <= radius + NEAR_MARGIN else "stopped away"

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from homing_train.figures.generalisation import (TILE, by_camera_height_markdown,
-                                                 failures_figure, load_results,
-                                                 per_scene_markdown)
+                                                 failure_kinds_markdown, failures_figure,
+                                                 load_results, per_scene_markdown)
 from homing_train.harness.evaluate import EpisodeRecord, EvalResult
 from homing_train.harness.matrix import setting_stem
 
@@ -52,6 +52,21 @@ def test_per_scene_table_counts_successes_with_wilson_intervals(tmp_path):
     assert "| snapshot | 0 [0, 66] (2) | 50 [9, 91] (2) | 25 [5, 70] (4) |" in table
 
 
+def test_failure_kinds_count_each_failed_episode_once_over_all_scenes(tmp_path):
+    _write_cell(tmp_path, "warping", {"arena": [True, False, False], "lab": [False, True]})
+    results = load_results(tmp_path)
+    # the hand-made failures: stopped 0.6 m away (the default radius 0.15 m + 0.1 m is
+    # 0.25 m); make one stuck (out of time, 8 of 10 steps in contact), one near, one lost
+    arena, lab = (r.result.episodes for r in results["warping"])
+    arena[1].truncated, arena[1].collisions = True, 8
+    arena[2].final_distance = 0.2
+    lab[0].truncated = True
+    table = failure_kinds_markdown(results).splitlines()
+    assert table[0] == ("| method | episodes | success | stuck | out of time | stopped near "
+                        "| stopped away |")
+    assert table[2] == "| warping | 5 | 2 | 1 | 1 | 1 | 0 |"
+
+
 def test_failures_figure_has_a_row_per_method_that_failed(tmp_path):
     _write_cell(tmp_path / "cells", "oracle", {"arena": [True, True]})
     _write_cell(tmp_path / "cells", "warping", {"arena": [True, False]})
@@ -69,12 +84,13 @@ def test_an_empty_folder_is_refused(tmp_path):
         load_results(tmp_path)
 
 
-def test_the_command_writes_the_table_and_three_figures(tmp_path):
+def test_the_command_writes_the_tables_and_three_figures(tmp_path):
     from homing_train.figures.generalisation import main
     _write_cell(tmp_path / "cells", "warping", {"arena": [True, False]})
     assert main(["--cells", str(tmp_path / "cells"), "--out", str(tmp_path / "out")]) == 0
     written = sorted(p.name for p in (tmp_path / "out").iterdir())
-    assert written == ["by_distance.png", "failures.png", "per_scene.md", "per_scene.png"]
+    assert written == ["by_distance.png", "failure_kinds.md", "failures.png", "per_scene.md",
+                       "per_scene.png"]
     assert imageio.imread(tmp_path / "out" / "by_distance.png").ndim == 3
 
 

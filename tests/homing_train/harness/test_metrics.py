@@ -8,8 +8,8 @@ import pytest
 from homing_gym.paths import segment_free, shortest_path
 from homing_gym.scenes.arena import arena_scene
 from homing_train.harness.evaluate import EpisodeRecord, summarize
-from homing_train.harness.metrics import (bootstrap_ci, distance_bins, path_length, soft_spl, spl,
-                                          wilson_interval)
+from homing_train.harness.metrics import (bootstrap_ci, distance_bins, failure_kind, path_length,
+                                          soft_spl, spl, wilson_interval)
 
 # a 3-4-5 detour: straight-line distance 5, travelled 7
 TRAJECTORY = [(0.0, 0.0), (3.0, 0.0), (3.0, 4.0)]
@@ -182,3 +182,14 @@ def test_every_summary_field_against_hand_computed_values():
     assert s["heading_error_deg_median"] == pytest.approx(30.0)
     assert s["reached_rate"] == pytest.approx(2 / 3)          # 0.05 and 0.12 <= 0.15 m
     assert s["reached_ci"] == list(wilson_interval(2, 3))
+
+
+@pytest.mark.parametrize("truncated, steps, collisions, final, kind", [
+    (True, 250, 75, 1.0, "stuck"),            # 30 % of its steps in contact
+    (True, 250, 74, 1.0, "out of time"),
+    (True, 250, 0, 0.16, "out of time"),      # near home, but it never stopped
+    (False, 40, 0, 0.25, "stopped near"),     # the 0.15 m radius + 0.1 m
+    (False, 40, 0, 0.2501, "stopped away"),
+    (False, 40, 200, 1.0, "stopped away")])   # contact does not matter for a stop
+def test_failure_kinds_follow_the_definitions(truncated, steps, collisions, final, kind):
+    assert failure_kind(truncated, steps, collisions, final, radius=0.15) == kind
