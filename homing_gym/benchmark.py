@@ -26,6 +26,11 @@ LocalHoming-v0 with the default camera): with a new world at every reset
 (``episodes_per_world=1``: the world drawn, the PyBullet bodies and the ray caster's mesh
 built) and in the same world (the saved state restored, a new episode sampled, the goal
 snapshot rendered); medians of 5 blocks of ``N`` resets.
+
+``--culling-bound N`` instead times the ray caster alone at ``N`` random poses of each
+world (the arena first, the first ``--shapes``): casting every triangle, and casting only
+the triangles that the panorama shows (the same pixels): what an oracle culler that knew
+the final image would cost, the most any culling of hidden triangles could gain.
 """
 
 from __future__ import annotations
@@ -43,6 +48,8 @@ import homing_gym  # noqa: F401  (registers the envs)
 from homing_gym.cli import command_parser, worker_count
 from homing_gym.config import MOTIONS
 from homing_gym.outputs import output_file_argument, write_text_atomic
+from homing_gym.render.raycast import RayCaster, scratch_buffers
+from homing_gym.render.worldmesh import WorldMesh
 from homing_gym.scenes import Landmark, MeshScene, Scene, scene_factory, square_walls
 from homing_gym.scenes.tussocks import tussock_blades
 
@@ -172,6 +179,72 @@ def render_rate(env: gym.Env, n: int, rng: np.random.Generator) -> float:
     for pose in poses:
         u.render_panorama(pose)
     return n / (time.perf_counter() - start)
+
+
+def shown_caster(caster: RayCaster, pose, camera_height: float, config) -> RayCaster:
+    """A ray caster of only the triangles that ``caster``'s panorama at ``pose`` (``(x, y,
+    yaw)``, metres and radians; ``camera_height`` metres, ``config`` a
+    :class:`~homing_gym.render.panorama.CameraConfig`) shows; its panorama there has the
+    same pixels. ``ValueError`` for a caster with shadows (hidden triangles cast them)."""
+    if caster.shadows:
+        raise ValueError("shadows=True: hidden triangles cast shadows, so the triangles "
+                         "shown alone do not make the same panorama; use shadows=False")
+    caster.panorama(pose, camera_height, config)
+    (H, W), k = config.panorama_shape, config.supersampling
+    hit = scratch_buffers(H * k, W * k)[0]           # the cast just made
+    ids = np.unique(hit[hit >= 0])
+    m = caster.mesh
+    shown = WorldMesh(m.triangles[ids], m.colors[ids], m.texture[ids], m.uvs[ids], m.textures,
+                      m.closed[ids])
+    return RayCaster(shown, caster.sky, False, caster.sky_zenith)
+
+
+def culling_bound(env: gym.Env, n: int, rng: np.random.Generator,
+                  repeats: int = 10) -> tuple[float, float, float]:
+    """``(every, shown, count)``: the median panoramas per second of the env's ray caster
+    over ``n`` random poses of its world (as :func:`render_rate`, ``repeats`` panoramas
+    each) casting every triangle and casting only those shown (:func:`shown_caster`),
+    and the median number of triangles shown."""
+    u = env.unwrapped
+    if u.sim.caster is None:
+        raise ValueError(f"renderer {u.camera.config.renderer!r}: the culling bound times "
+                         "the ray caster, renderer='raycast'")
+    (xmin, ymin), (xmax, ymax) = u.scene.bounds
+    h, config = u.camera.camera_height, u.camera.config
+    every, shown, counts = [], [], []
+    for _ in range(n):
+        pose = (rng.uniform(xmin, xmax), rng.uniform(ymin, ymax), rng.uniform(-np.pi, np.pi))
+        sub = shown_caster(u.sim.caster, pose, h, config)
+        for caster, rates in ((u.sim.caster, every), (sub, shown)):
+            caster.panorama(pose, h, config)
+            start = time.perf_counter()
+            for _ in range(repeats):
+                caster.panorama(pose, h, config)
+            rates.append(repeats / (time.perf_counter() - start))
+        counts.append(len(sub.mesh.triangles))
+    return float(np.median(every)), float(np.median(shown)), float(np.median(counts))
+
+
+def culling_bound_table(worlds: list[str], shape: tuple[int, int], n: int) -> str:
+    """A Markdown table of :func:`culling_bound` in the arena and each of ``worlds``
+    (LocalHoming-v0, ``shape`` panoramas); ``vs arena``: the shown-only rate over the
+    arena's every-triangle rate, same run."""
+    lines = ["| world | triangles | shown (median) | every triangle (pano/s) | "
+             "shown only (pano/s) | shown only vs arena |", "|---|---:|---:|---:|---:|---:|"]
+    arena = None
+    for world in tqdm(["arena", *(w for w in worlds if w != "arena")], desc="culling bound"):
+        env = gym.make("homing_gym/LocalHoming-v0", renderer="raycast",
+                       panorama_shape=shape, **world_kwargs(world))
+        env.reset(seed=0)
+        try:
+            every, shown, count = culling_bound(env, n, np.random.default_rng(0))
+            triangles = len(env.unwrapped.sim.caster.mesh.triangles)
+        finally:
+            env.close()
+        arena = arena or every
+        lines.append(f"| {world} | {triangles} | {count:.0f} | {every:.0f} | {shown:.0f} | "
+                     f"{shown / arena:.2f}x |")
+    return "\n".join(lines)
 
 
 def step_rate(env, n: int, batch: int = 1) -> float:
@@ -320,9 +393,21 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--motion", choices=MOTIONS, default=MOTIONS[0],
                         help="the robot's motion model in every configuration (--vec "
                              "native; 'kinematic': homing_gym.sim.kinematic)")
+    parser.add_argument("--culling-bound", type=int, metavar="N",
+                        help="instead time the ray caster at N random poses per world (the "
+                             "arena first, the first --shapes): every triangle against only "
+                             "those each panorama shows, the most culling could gain")
     args = parser.parse_args(argv)
     if args.steps < 10 or args.resets < 0:
         parser.error("need --steps >= 10 and --resets >= 0")
+    if args.culling_bound is not None and args.culling_bound < 1:
+        parser.error(f"--culling-bound {args.culling_bound}: need N >= 1 poses")
+    if args.culling_bound:
+        try:
+            print(culling_bound_table(args.worlds, SHAPES[args.shapes[0]], args.culling_bound))
+        except ValueError as err:
+            parser.error(f"--worlds: {err}")
+        return 0
     if args.vec == "native":
         return _native(args, parser)
     try:

@@ -133,3 +133,16 @@ def test_benchmark_runs_in_a_mesh_world_and_refuses_an_unknown_one(tmp_path, cap
     assert err.value.code == 2
     assert "world 'moon': neither a benchmark world" in capsys.readouterr().err
     assert not (tmp_path / "no.json").exists()
+
+
+def test_the_culling_bound_times_the_arena_first_and_refuses_no_poses(capsys):
+    from homing_gym.benchmark import main
+
+    assert main(["--culling-bound", "1", "--worlds", "grass10k"]) == 0
+    rows = [line for line in capsys.readouterr().out.splitlines() if line.startswith("| ")]
+    cells = [row.strip("| ").split(" | ") for row in rows[1:]]
+    assert [(c[0], c[1]) for c in cells] == [("arena", "1074"), ("grass10k", "10002")]
+    assert all(0 < int(c[2]) < int(c[1]) for c in cells)       # some triangles shown
+    with pytest.raises(SystemExit):
+        main(["--culling-bound", "0"])
+    assert "--culling-bound 0: need N >= 1 poses" in capsys.readouterr().err

@@ -216,3 +216,20 @@ def test_the_caster_never_reads_or_writes_outside_its_arrays(tmp_path):
     run = subprocess.run([sys.executable, "-c", _ODD_CAMERAS], env=env, capture_output=True,
                          text=True, timeout=600)
     assert run.returncode == 0, run.stderr[-3000:]
+
+
+def test_the_triangles_a_panorama_shows_make_the_same_panorama_alone():
+    from homing_gym.benchmark import shown_caster
+    from homing_gym.render.panorama import CameraConfig
+    from homing_gym.render.raycast import RayCaster
+
+    mesh = world_mesh(grass_world(5000))
+    caster, config = RayCaster(mesh), CameraConfig()
+    rng = np.random.default_rng(3)
+    for x, y, yaw in zip(*rng.uniform(-4.5, 4.5, (2, 6)), rng.uniform(-math.pi, math.pi, 6)):
+        full = caster.panorama((x, y, yaw), 0.3, config)
+        alone = shown_caster(caster, (x, y, yaw), 0.3, config)
+        assert 0 < len(alone.mesh.triangles) < len(mesh.triangles) // 2
+        np.testing.assert_array_equal(alone.panorama((x, y, yaw), 0.3, config), full)
+    with pytest.raises(ValueError, match="shadows=True"):
+        shown_caster(RayCaster(mesh, shadows=True), (0.0, 0.0, 0.0), 0.3, config)
