@@ -169,12 +169,18 @@ class BenchmarkResult:
         return self.render_per_s / self.env_steps_per_s
 
 
+def random_poses(env: gym.Env, n: int, rng: np.random.Generator) -> np.ndarray:
+    """``(n, 3)`` poses ``(x, y, yaw)`` (metres, radians) drawn uniformly in the bounds of
+    the env's world and over all headings."""
+    (xmin, ymin), (xmax, ymax) = env.unwrapped.scene.bounds
+    return np.column_stack([rng.uniform(xmin, xmax, n), rng.uniform(ymin, ymax, n),
+                            rng.uniform(-np.pi, np.pi, n)])
+
+
 def render_rate(env: gym.Env, n: int, rng: np.random.Generator) -> float:
     """Panoramas per second rendered at random poses of the env's world."""
     u = env.unwrapped
-    (xmin, ymin), (xmax, ymax) = u.scene.bounds
-    poses = np.column_stack([rng.uniform(xmin, xmax, n), rng.uniform(ymin, ymax, n),
-                             rng.uniform(-np.pi, np.pi, n)])
+    poses = random_poses(env, n, rng)
     start = time.perf_counter()
     for pose in poses:
         u.render_panorama(pose)
@@ -209,11 +215,9 @@ def culling_bound(env: gym.Env, n: int, rng: np.random.Generator,
     if u.sim.caster is None:
         raise ValueError(f"renderer {u.camera.config.renderer!r}: the culling bound times "
                          "the ray caster, renderer='raycast'")
-    (xmin, ymin), (xmax, ymax) = u.scene.bounds
     h, config = u.camera.camera_height, u.camera.config
     every, shown, counts = [], [], []
-    for _ in range(n):
-        pose = (rng.uniform(xmin, xmax), rng.uniform(ymin, ymax), rng.uniform(-np.pi, np.pi))
+    for pose in random_poses(env, n, rng):
         sub = shown_caster(u.sim.caster, pose, h, config)
         for caster, rates in ((u.sim.caster, every), (sub, shown)):
             caster.panorama(pose, h, config)

@@ -3,16 +3,18 @@ saw: every saved checkpoint of ``homing-train`` runs scored on a protocol.
 
 ``python -m homing_train.figures.checkpoints runs/A runs/B --protocol unseen --episodes 5 --every 50000 4096 --out docs/generalisation``
 
-scores ``RUN/checkpoints/ppo_<steps>_steps.zip`` (every ``--every`` steps; one value per run, or one for all), the
-final ``RUN/model.zip`` and, where the run has one, ``RUN/pretrain_model.zip`` (the warm
+scores ``RUN/checkpoints/ppo_<steps>_steps.zip`` (every ``--every`` steps; one value per run, or one for all;
+``--since STEPS``: only those at ``STEPS`` or later), the
+final ``RUN/model.zip`` and, where the run has one and ``--since`` is 0, ``RUN/pretrain_model.zip`` (the warm
 start, drawn before step 0) on
 ``--protocol`` with ``--episodes`` per setting, each with the settings recorded in the run
 (:func:`homing_train.harness.policies.recorded_settings`), the harness's stop rule and
-deterministic actions unless the run evaluated stochastically. Each checkpoint's cell is
+deterministic actions unless the run evaluated stochastically, in ``--workers`` processes. Each checkpoint's cell is
 kept in ``RUN/checkpoint_cells/<protocol>/<steps>/``, so an interrupted command resumes.
 Writes ``checkpoints_<protocol>.png`` (one panel per run: success % with Wilson 95 %
 intervals against env steps; dashed: the run's own evaluations on held-out *training*
-seeds from ``evaluations.npz``) and ``checkpoints_<protocol>.md`` (the table).
+seeds from ``evaluations.npz``) and ``checkpoints_<protocol>.md`` (the table, with each
+setting's success where the protocol has several).
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ from __future__ import annotations
 import json
 import re
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -37,25 +39,29 @@ PRETRAIN_STEP = -1
 RUN_COLOURS = ("#D55E00", "#009E73", "#0072B2", "#E69F00", "#CC79A7", "#56B4E9")
 
 
-@dataclass
+@dataclass(frozen=True)
 class CheckpointScore:
     """One checkpoint's cell: env steps (``PRETRAIN_STEP`` for the warm start), episodes,
-    successes under the stop rule, the Wilson 95 % interval and the command."""
+    successes under the stop rule, the Wilson 95 % interval, the command and each
+    setting's success rate (label -> fraction)."""
 
     steps: int
     episodes: int
     successes: int
     ci: tuple[float, float]
     command: str
+    per_setting: dict[str, float] = field(default_factory=dict)
 
 
-def run_checkpoints(run: Path, every: int) -> list[tuple[int, Path]]:
-    """``(steps, zip)`` of the run's warm start (if any), of its checkpoints spaced by
-    ``every`` steps (the first at ``every`` or later, then each at least ``every`` past
-    the last one taken: the multiples of ``every`` where the run saved them, and still
-    evenly spread after a resume shifted its checkpoints) and of its final
-    ``model.zip`` (at the steps in ``summary.json``, where the run finished), in step
-    order."""
+def run_checkpoints(run: Path, every: int, since: int = 0) -> list[tuple[int, Path]]:
+    """``(steps, zip)`` of the run's warm start (if any, and ``since`` is 0), of its
+    checkpoints spaced by ``every`` steps (the first at ``every`` or later, then each at
+    least ``every`` past the last one taken: the multiples of ``every`` where the run
+    saved them, and still evenly spread after a resume shifted its checkpoints) and of
+    its final ``model.zip`` (at the steps in ``summary.json``, where the run finished),
+    in step order; only those at ``since`` steps or later."""
+    if since < 0:
+        raise ValueError(f"since must be >= 0 env steps, got {since}")
     found = sorted((int(m.group(1)), p) for p in (run / "checkpoints").glob("ppo_*_steps.zip")
                    if (m := _CHECKPOINT.search(p.name)))
     chosen: list[tuple[int, Path]] = []
@@ -67,8 +73,9 @@ def run_checkpoints(run: Path, every: int) -> list[tuple[int, Path]]:
         chosen.append((final, run / "model.zip"))
     if (run / "pretrain_model.zip").is_file():
         chosen.insert(0, (PRETRAIN_STEP, run / "pretrain_model.zip"))
+    chosen = [(s, p) for s, p in chosen if s >= since or (since == 0 and s == PRETRAIN_STEP)]
     if not chosen:
-        raise ValueError(f"{run} has no checkpoints at {every} steps or later "
+        raise ValueError(f"{run} has no checkpoints at {max(every, since)} steps or later "
                          f"(found {[s for s, _ in found]}) and no pretrain_model.zip")
     return chosen
 
@@ -80,17 +87,20 @@ def _final_steps(run: Path) -> int | None:
 
 
 def score_run(run: Path, protocol_name: str, episodes: int, every: int,
-              progress: bool = True) -> list[CheckpointScore]:
+              progress: bool = True, since: int = 0, workers: int = 1) -> list[CheckpointScore]:
     """Every chosen checkpoint of ``run`` scored on the protocol (resuming kept cells)."""
     chosen_protocol = protocol(protocol_name)
     scores = []
-    for steps, model in run_checkpoints(run, every):
+    for steps, model in run_checkpoints(run, every, since):
         out = run / "checkpoint_cells" / protocol_name / str(steps)
         cell = run_cell(chosen_protocol, str(model), out, episodes=episodes,
-                        progress=progress, resume=True)
+                        workers=workers, progress=progress, resume=True)
         n = cell.summary["episodes"]
+        per_setting = ({label: s["success_rate"] for label, s in cell.settings.items()}
+                       if len(cell.settings) > 1 else {})
         scores.append(CheckpointScore(steps, n, round(cell.summary["success_rate"] * n),
-                                      tuple(cell.summary["success_ci"]), cell.command))
+                                      tuple(cell.summary["success_ci"]), cell.command,
+                                      per_setting))
     return scores
 
 
@@ -106,13 +116,19 @@ def training_evaluations(run: Path) -> tuple[np.ndarray, np.ndarray]:
 
 
 def markdown(results: dict[str, list[CheckpointScore]], protocol_name: str) -> str:
-    """One row per run and checkpoint: success % [Wilson 95 % CI] (k/n)."""
-    rows = [f"| run | env steps | {protocol_name}: success % [95% CI] | episodes |",
-            "|---|---:|---:|---:|"]
+    """One row per run and checkpoint: success % [Wilson 95 % CI] (k/n), after each
+    setting's success % where the scores have them."""
+    labels = list(dict.fromkeys(k for scores in results.values() for s in scores
+                                for k in s.per_setting))
+    rows = [f"| run | env steps | {''.join(f'{k} | ' for k in labels)}"
+            f"{protocol_name}: success % [95% CI] | episodes |",
+            "|---|---:|" + "---:|" * len(labels) + "---:|---:|"]
     for run, scores in results.items():
         for s in scores:
             steps = "warm start" if s.steps == PRETRAIN_STEP else f"{s.steps:,}"
-            rows.append(f"| {run} | {steps} | {100 * s.successes / s.episodes:.0f} "
+            settings = "".join(f"{100 * s.per_setting[k]:.0f} | " if k in s.per_setting
+                               else "- | " for k in labels)
+            rows.append(f"| {run} | {steps} | {settings}{100 * s.successes / s.episodes:.0f} "
                         f"[{100 * s.ci[0]:.0f}, {100 * s.ci[1]:.0f}] | "
                         f"{s.successes}/{s.episodes} |")
     return "\n".join(rows) + "\n"
@@ -165,18 +181,24 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--every", type=int, nargs="+", default=[50000],
                         help="score checkpoints this many steps apart (one value for "
                              "every run, or one per run)")
+    parser.add_argument("--since", type=int, default=0,
+                        help="only checkpoints at this many env steps or later")
+    parser.add_argument("--workers", type=int, default=1, help="parallel processes")
     parser.add_argument("--out", type=output_dir_argument, default="docs/generalisation")
     parser.add_argument("--no-progress", action="store_true")
     args = parser.parse_args(argv)
     if len(args.every) == 1:
         args.every *= len(args.runs)
-    if args.episodes < 1 or min(args.every) < 1 or len(args.every) != len(args.runs):
-        parser.error(f"--episodes and --every must be >= 1, and --every one value or one "
-                     f"per run; got {args.episodes}, {args.every} for {len(args.runs)} runs")
+    if (args.episodes < 1 or min(args.every) < 1 or len(args.every) != len(args.runs)
+            or args.since < 0 or args.workers < 1):
+        parser.error(f"--episodes, --every and --workers must be >= 1, --since >= 0, and "
+                     f"--every one value or one per run; got --episodes {args.episodes}, "
+                     f"--every {args.every} for {len(args.runs)} runs, --since {args.since}, "
+                     f"--workers {args.workers}")
     runs = {run.name: run for run in args.runs}
     try:
         results = {name: score_run(run, args.protocol, args.episodes, every,
-                                   not args.no_progress)
+                                   not args.no_progress, args.since, args.workers)
                    for (name, run), every in zip(runs.items(), args.every)}
     except ValueError as err:
         parser.exit(2, f"checkpoints: error: {err}\n")
